@@ -1,0 +1,6 @@
+//! Rod models: discretisation, state, energies, and the continuum (shooting) ODE.
+
+pub mod energy;
+pub mod frames;
+pub mod rod;
+pub mod shooting;

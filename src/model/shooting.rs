@@ -1,0 +1,156 @@
+//! The continuum Kirchhoff equilibrium equations (A.2) integrated from s = 0,
+//! used to build initial shapes from published shooting data (n(0), m(0)) and as
+//! an independent reference (the paper's own method) in validation.
+
+use crate::model::rod::{Clamps, wrap};
+use nalgebra::{SVector, Vector3, Vector6};
+use std::f64::consts::PI;
+
+/// State of (A.2): r, d1, d2, d3, n (material), m (material), and ∫u3 ds.
+pub type OdeState = SVector<f64, 19>;
+
+fn part(y: &OdeState, k: usize) -> Vector3<f64> {
+    Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
+}
+
+/// Right-hand side of (A.2) for K2, K3 (B11 = 1, no external force).
+pub fn rhs(y: &OdeState, k2: f64, k3: f64) -> OdeState {
+    let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
+    let n = part(y, 4);
+    let m = part(y, 5);
+    let u = Vector3::new(m[0], m[1] / k2, m[2] / k3);
+    let mut f = OdeState::zeros();
+    let set = |f: &mut OdeState, k: usize, v: Vector3<f64>| {
+        f[3 * k] = v[0];
+        f[3 * k + 1] = v[1];
+        f[3 * k + 2] = v[2];
+    };
+    set(&mut f, 0, d3);
+    set(&mut f, 1, u[2] * d2 - u[1] * d3);
+    set(&mut f, 2, u[0] * d3 - u[2] * d1);
+    set(&mut f, 3, u[1] * d1 - u[0] * d2);
+    // n' = n × u, m' = m × u + n × d3 (components in the material frame)
+    set(&mut f, 4, n.cross(&u));
+    set(&mut f, 5, m.cross(&u) + Vector3::new(n[1], -n[0], 0.0));
+    f[18] = u[2];
+    f
+}
+
+/// A solution of (A.2) on [0, 1] sampled on a uniform grid (classical RK4).
+#[derive(Clone, Debug)]
+pub struct ShootingSolution {
+    /// Samples at s = k / steps.
+    pub samples: Vec<OdeState>,
+    /// Bending ratios.
+    pub k2: f64,
+    /// Twisting ratio.
+    pub k3: f64,
+}
+
+impl ShootingSolution {
+    /// Integrate from r = 0, d_i = e_i, with n(0), m(0) in the material frame.
+    pub fn integrate(n0: Vector3<f64>, m0: Vector3<f64>, k2: f64, k3: f64, steps: usize) -> Self {
+        let mut y = OdeState::zeros();
+        y[3] = 1.0;
+        y[7] = 1.0;
+        y[11] = 1.0;
+        for c in 0..3 {
+            y[12 + c] = n0[c];
+            y[15 + c] = m0[c];
+        }
+        let ds = 1.0 / steps as f64;
+        let mut samples = Vec::with_capacity(steps + 1);
+        samples.push(y);
+        for _ in 0..steps {
+            let a = rhs(&y, k2, k3);
+            let b = rhs(&(y + 0.5 * ds * a), k2, k3);
+            let c = rhs(&(y + 0.5 * ds * b), k2, k3);
+            let d = rhs(&(y + ds * c), k2, k3);
+            y += ds / 6.0 * (a + 2.0 * b + 2.0 * c + d);
+            samples.push(y);
+        }
+        ShootingSolution { samples, k2, k3 }
+    }
+
+    /// State at s by cubic Hermite interpolation with the exact derivative (A.2).
+    pub fn at(&self, s: f64) -> OdeState {
+        let steps = self.samples.len() - 1;
+        let x = (s.clamp(0.0, 1.0) * steps as f64).min(steps as f64 - 1e-12);
+        let k = x.floor() as usize;
+        let t = x - k as f64;
+        let ds = 1.0 / steps as f64;
+        let (y0, y1) = (&self.samples[k], &self.samples[k + 1]);
+        let (f0, f1) = (rhs(y0, self.k2, self.k3), rhs(y1, self.k2, self.k3));
+        let h00 = 2.0 * t * t * t - 3.0 * t * t + 1.0;
+        let h10 = t * t * t - 2.0 * t * t + t;
+        let h01 = -2.0 * t * t * t + 3.0 * t * t;
+        let h11 = t * t * t - t * t;
+        h00 * y0 + h10 * ds * f0 + h01 * y1 + h11 * ds * f1
+    }
+
+    /// Centreline r(s).
+    pub fn position(&self, s: f64) -> Vector3<f64> {
+        part(&self.at(s), 0)
+    }
+
+    /// Director d1(s).
+    pub fn d1(&self, s: f64) -> Vector3<f64> {
+        part(&self.at(s), 1)
+    }
+
+    /// The end state at s = 1.
+    pub fn end(&self) -> &OdeState {
+        self.samples.last().unwrap()
+    }
+
+    /// Total twist (1/2π) ∫ u3 ds.
+    pub fn twist(&self) -> f64 {
+        self.end()[18] / (2.0 * PI)
+    }
+
+    /// Mismatch of the s = 1 boundary conditions (2.10)-(2.11) for `clamps`:
+    /// r(1) - r*, d3x(1), d3y(1), and the angle of d1 minus φ (mod 2π).
+    pub fn boundary_residual(&self, clamps: &Clamps) -> Vector6<f64> {
+        let y = self.end();
+        let r = part(y, 0) - clamps.end_point();
+        let d1 = part(y, 1);
+        let d3 = part(y, 3);
+        Vector6::new(r[0], r[1], r[2], d3[0], d3[1], wrap(d1[1].atan2(d1[0]) - clamps.phi))
+    }
+}
+
+/// Refine published shooting data (n(0), m(0)) by Newton's method on the six
+/// boundary conditions at s = 1 (Jacobian by central differences: this is the
+/// paper's own method, used only to make a reference, never in the rod solver).
+pub fn refine_shooting(
+    n0: Vector3<f64>,
+    m0: Vector3<f64>,
+    k2: f64,
+    k3: f64,
+    clamps: &Clamps,
+    steps: usize,
+) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    let mut p = Vector6::new(n0[0], n0[1], n0[2], m0[0], m0[1], m0[2]);
+    let res = |p: &Vector6<f64>| {
+        ShootingSolution::integrate(p.fixed_rows::<3>(0).into(), p.fixed_rows::<3>(3).into(), k2, k3, steps)
+            .boundary_residual(clamps)
+    };
+    for _ in 0..30 {
+        let r = res(&p);
+        if r.norm() < 1e-11 {
+            return Some((p.fixed_rows::<3>(0).into(), p.fixed_rows::<3>(3).into()));
+        }
+        let mut jac = nalgebra::Matrix6::zeros();
+        for c in 0..6 {
+            let eps = 1e-6 * (1.0 + p[c].abs());
+            let mut pp = p;
+            pp[c] += eps;
+            let mut pm = p;
+            pm[c] -= eps;
+            jac.set_column(c, &((res(&pp) - res(&pm)) / (2.0 * eps)));
+        }
+        let dp = jac.lu().solve(&(-r))?;
+        p += dp;
+    }
+    None
+}

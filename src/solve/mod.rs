@@ -1,0 +1,4 @@
+//! Solvers: sparse linear algebra and Newton's method for equilibria.
+
+pub mod newton;
+pub mod sparse;

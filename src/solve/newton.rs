@@ -1,0 +1,233 @@
+//! Newton's method for equilibria of the discrete rod: energy minimisation with
+//! a line search and a diagonal shift for indefinite Hessians.
+
+use crate::model::energy::RodEnergy;
+use crate::model::rod::RodState;
+use crate::solve::sparse::Ldlt;
+use serde::{Deserialize, Serialize};
+
+/// Settings of the Newton minimiser.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct NewtonSettings {
+    /// Stop when ‖∇E‖ ≤ tol × (scale of the internal forces).
+    pub gradient_tol: f64,
+    /// Give up after this many iterations.
+    pub max_iterations: usize,
+    /// Largest node displacement of one step (a step is scaled down to it).
+    pub max_step: f64,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        NewtonSettings {
+            gradient_tol: 1e-10,
+            max_iterations: 200,
+            max_step: 0.05,
+        }
+    }
+}
+
+/// What one Newton solve did.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct NewtonReport {
+    /// Whether the gradient test was met.
+    pub converged: bool,
+    /// Newton iterations taken.
+    pub iterations: usize,
+    /// Relative gradient norm at each iterate (the residual history).
+    pub residual_history: Vec<f64>,
+    /// Final relative gradient norm.
+    pub gradient_norm: f64,
+    /// Final energy.
+    pub energy: f64,
+    /// Number of numerical factorisations.
+    pub factorizations: usize,
+}
+
+/// Why a solve failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    /// No convergence within the iteration budget.
+    #[error("Newton did not converge in {iterations} iterations (relative gradient {residual:.3e})")]
+    NotConverged {
+        /// Iterations taken.
+        iterations: usize,
+        /// Final relative gradient.
+        residual: f64,
+    },
+    /// A NaN or infinity appeared.
+    #[error("non-finite value in {step} at Newton iteration {iteration}")]
+    NonFinite {
+        /// Where it appeared.
+        step: &'static str,
+        /// At which iteration.
+        iteration: usize,
+    },
+    /// The line search could not decrease the energy.
+    #[error("line search failed at Newton iteration {iteration} (relative gradient {residual:.3e})")]
+    LineSearch {
+        /// At which iteration.
+        iteration: usize,
+        /// Relative gradient there.
+        residual: f64,
+    },
+}
+
+/// A Newton minimiser bound to one energy (its sparse pattern and symbolic
+/// factorisation are reused across iterations and solves).
+pub struct Newton {
+    /// The energy being minimised.
+    pub energy: RodEnergy,
+    /// Factorisation workspace.
+    pub ldlt: Ldlt,
+    grad: Vec<f64>,
+    values: Vec<f64>,
+    step: Vec<f64>,
+}
+
+impl Newton {
+    /// A minimiser for `energy`.
+    pub fn new(energy: RodEnergy) -> Self {
+        let n = energy.map.len();
+        let nnz = energy.pattern.nnz();
+        let ldlt = Ldlt::new(&energy.pattern);
+        Newton {
+            energy,
+            ldlt,
+            grad: vec![0.0; n],
+            values: vec![0.0; nnz],
+            step: vec![0.0; n],
+        }
+    }
+
+    /// Minimise the energy from `state` (updated in place).
+    pub fn minimize(
+        &mut self,
+        state: &mut RodState,
+        settings: &NewtonSettings,
+    ) -> Result<NewtonReport, SolveError> {
+        let mut report = NewtonReport {
+            converged: false,
+            iterations: 0,
+            residual_history: Vec::new(),
+            gradient_norm: f64::NAN,
+            energy: f64::NAN,
+            factorizations: 0,
+        };
+        let mut shift = 0.0f64;
+        let mut trial = state.clone();
+        for it in 0..=settings.max_iterations {
+            let info = self.energy.hessian(state, &mut self.grad, &mut self.values);
+            let gnorm = norm(&self.grad);
+            if !info.energy.is_finite() || !gnorm.is_finite() {
+                return Err(SolveError::NonFinite {
+                    step: "energy/gradient evaluation",
+                    iteration: it,
+                });
+            }
+            let rel = if info.force_scale > 1e-300 {
+                gnorm / info.force_scale
+            } else {
+                0.0
+            };
+            report.residual_history.push(rel);
+            report.gradient_norm = rel;
+            report.energy = info.energy;
+            report.iterations = it;
+            if rel <= settings.gradient_tol || gnorm < 1e-13 {
+                report.converged = true;
+                return Ok(report);
+            }
+            if it == settings.max_iterations {
+                break;
+            }
+            // Newton direction with the smallest diagonal shift that makes the
+            // Hessian positive definite (a descent direction for minimisation).
+            let diag_scale = self
+                .energy
+                .pattern
+                .diagonal
+                .iter()
+                .map(|&s| self.values[s].abs())
+                .fold(0.0, f64::max)
+                .max(1e-300);
+            shift = (shift * 0.1).max(0.0);
+            if shift < 1e-12 * diag_scale {
+                shift = 0.0;
+            }
+            loop {
+                for &s in &self.energy.pattern.diagonal {
+                    self.values[s] += shift;
+                }
+                report.factorizations += 1;
+                let ok = self.ldlt.factor(&self.values).is_ok() && self.ldlt.negative_count() == 0;
+                for &s in &self.energy.pattern.diagonal {
+                    self.values[s] -= shift;
+                }
+                if ok {
+                    break;
+                }
+                shift = if shift == 0.0 { 1e-8 * diag_scale } else { shift * 10.0 };
+                if shift > 1e6 * diag_scale {
+                    return Err(SolveError::NonFinite {
+                        step: "Hessian regularisation",
+                        iteration: it,
+                    });
+                }
+            }
+            for (s, g) in self.step.iter_mut().zip(&self.grad) {
+                *s = -g;
+            }
+            self.ldlt.solve_in_place(&mut self.step);
+            if self.step.iter().any(|v| !v.is_finite()) {
+                return Err(SolveError::NonFinite {
+                    step: "Newton step",
+                    iteration: it,
+                });
+            }
+            // cap the largest node move
+            let map = self.energy.map;
+            let largest = (0..self.step.len())
+                .filter(|&d| map.is_translation(d))
+                .map(|d| self.step[d].abs())
+                .fold(0.0, f64::max);
+            if largest > settings.max_step {
+                let f = settings.max_step / largest;
+                self.step.iter_mut().for_each(|v| *v *= f);
+            }
+            // Armijo backtracking on the energy
+            let slope: f64 = self.step.iter().zip(&self.grad).map(|(s, g)| s * g).sum();
+            let mut alpha = 1.0;
+            let mut accepted = false;
+            for _ in 0..40 {
+                let scaled: Vec<f64> = self.step.iter().map(|v| alpha * v).collect();
+                state.displace_into(&map, &scaled, &mut trial);
+                let e = self.energy.energy(&trial);
+                // near convergence the energy decrease is below round-off: accept
+                // a full step whose energy is equal to working precision
+                let tol = 1e-14 * info.energy.abs().max(1.0);
+                if e.is_finite() && e <= info.energy + 1e-4 * alpha * slope + tol {
+                    accepted = true;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            if !accepted {
+                return Err(SolveError::LineSearch {
+                    iteration: it,
+                    residual: rel,
+                });
+            }
+            std::mem::swap(state, &mut trial);
+        }
+        Err(SolveError::NotConverged {
+            iterations: report.iterations,
+            residual: report.gradient_norm,
+        })
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
