@@ -1,5 +1,10 @@
 //! knotrod: equilibria, stability and knot diagnostics of clamped elastic rods
 //! (discrete elastic rods), after "Stable elastic knots with no self-contact".
 
+pub mod cli;
+pub mod equilibrium;
 pub mod model;
+pub mod scene;
 pub mod solve;
+pub mod stability;
+pub mod summary;

@@ -9,7 +9,10 @@ use nalgebra::Vector3;
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
     }
 }
@@ -26,7 +29,13 @@ fn random_state(n: usize, seed: u64) -> (RodModel, RodState) {
     let base = RodState::from_curve(
         n,
         clamps,
-        |s| Vector3::new(0.2 * (6.0 * s).sin(), 0.15 * (1.0 - (5.0 * s).cos()), 0.4 * s),
+        |s| {
+            Vector3::new(
+                0.2 * (6.0 * s).sin(),
+                0.15 * (1.0 - (5.0 * s).cos()),
+                0.4 * s,
+            )
+        },
         |s| Vector3::new((3.0 * s).cos(), (3.0 * s).sin(), 0.0),
     );
     let map = RodEnergy::new(model.clone()).map;
@@ -38,7 +47,12 @@ fn random_state(n: usize, seed: u64) -> (RodModel, RodState) {
 }
 
 fn rel(a: &[f64], b: &[f64]) -> f64 {
-    let d: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+    let d: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt();
     let s: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt();
     d / s
 }
@@ -70,7 +84,12 @@ fn check(terms: Terms, seed: u64) {
     for a in 0..n {
         for b in a..n {
             let mut v = 0.0;
-            for (sa, sb, w) in [(1.0, 1.0, 1.0), (1.0, -1.0, -1.0), (-1.0, 1.0, -1.0), (-1.0, -1.0, 1.0)] {
+            for (sa, sb, w) in [
+                (1.0, 1.0, 1.0),
+                (1.0, -1.0, -1.0),
+                (-1.0, 1.0, -1.0),
+                (-1.0, -1.0, 1.0),
+            ] {
                 let mut dq = vec![0.0; n];
                 dq[a] += sa * eps;
                 dq[b] += sb * eps;

@@ -315,7 +315,8 @@ impl RodEnergy {
                 let c = VertexFrames::at(state, i);
                 let q = SVector::<f64, 11>::from(vertex_variables(state, i));
                 let dofs = self.map.vertex_stencil(i);
-                let f = |v: SVector<_, 11>| vertex_energy(v.as_slice(), &c, &self.model, self.terms);
+                let f =
+                    |v: SVector<_, 11>| vertex_energy(v.as_slice(), &c, &self.model, self.terms);
                 match values.as_deref_mut() {
                     Some(vals) => {
                         let (e, gl, hl) = num_dual::hessian(f, &q);
@@ -388,5 +389,41 @@ fn scatter_hessian(slots: &[usize], m: usize, local: &[f64], values: &mut [f64])
                 values[s] += local[b * m + a];
             }
         }
+    }
+}
+
+/// Force n(0) and moment m(0) at s = 0 (components in the material frame there,
+/// which is the lab frame): the internal force and moment that the rod s > 0
+/// exerts across s = 0, i.e. minus the derivative of the energy with respect to
+/// a rigid translation and rotation (about the origin) of the s = 0 clamp.
+#[derive(Clone, Copy, Debug)]
+pub struct ClampReactions {
+    /// n(0).
+    pub force: Vector3<f64>,
+    /// m(0).
+    pub moment: Vector3<f64>,
+}
+
+impl RodEnergy {
+    /// Internal force and moment at s = 0 from the discrete solution.
+    pub fn clamp_reactions(&self, state: &RodState) -> ClampReactions {
+        let g = self.full_gradient(state);
+        let force = -(g.nodes[0] + g.nodes[1]);
+        // a rotation ω moves clamp nodes by ω × x and turns the clamp's frame by
+        // ω; about e3 that is a change of θ_0 (for ω ⟂ e3 time-parallel transport
+        // of the clamp's reference director is the rigid rotation to first order)
+        let moment = -(state.nodes[0].cross(&g.nodes[0])
+            + state.nodes[1].cross(&g.nodes[1])
+            + g.theta[0] * Vector3::z());
+        ClampReactions { force, moment }
+    }
+
+    /// Lumped mass of each free dof: the segment length for node coordinates,
+    /// zero for material angles (no rotational inertia, as in the paper).
+    pub fn lumped_mass(&self) -> Vec<f64> {
+        let h = self.model.segment_length();
+        (0..self.map.len())
+            .map(|d| if self.map.is_translation(d) { h } else { 0.0 })
+            .collect()
     }
 }

@@ -73,7 +73,10 @@ pub fn signed_angle<T: Scalar>(a: V3<T>, b: V3<T>, t: V3<T>) -> T {
 pub fn material_directors<T: Scalar>(t: V3<T>, a1: V3<T>, theta: T) -> (V3<T>, V3<T>) {
     let a2 = cross(t, a1);
     let (s, c) = theta.sin_cos();
-    (add(scale(c, a1), scale(s, a2)), sub(scale(c, a2), scale(s, a1)))
+    (
+        add(scale(c, a1), scale(s, a2)),
+        sub(scale(c, a2), scale(s, a1)),
+    )
 }
 
 #[cfg(test)]

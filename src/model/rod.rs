@@ -205,9 +205,7 @@ impl RodState {
         let h = 1.0 / n as f64;
         let e3 = Vector3::z();
         let end = clamps.end_point();
-        let mut nodes: Vec<Vector3<f64>> = (0..n + 2)
-            .map(|i| r((i as f64 - 0.5) * h))
-            .collect();
+        let mut nodes: Vec<Vector3<f64>> = (0..n + 2).map(|i| r((i as f64 - 0.5) * h)).collect();
         nodes[0] = -0.5 * h * e3;
         nodes[1] = 0.5 * h * e3;
         nodes[n] = end - 0.5 * h * e3;
@@ -216,7 +214,11 @@ impl RodState {
         // twist in between
         let mut reference = vec![Vector3::x(); n + 1];
         for j in 1..n {
-            let a = transport(&reference[j - 1], &tangent(&nodes, j - 1), &tangent(&nodes, j));
+            let a = transport(
+                &reference[j - 1],
+                &tangent(&nodes, j - 1),
+                &tangent(&nodes, j),
+            );
             // re-orthonormalise against round-off drift
             let t = tangent(&nodes, j);
             reference[j] = (a - a.dot(&t) * t).normalize();
@@ -314,7 +316,10 @@ impl RodState {
 
     /// Total twist Tw = (1/2π) ∫ u3 ds.
     pub fn twist(&self) -> f64 {
-        (1..=self.segments()).map(|i| self.vertex_twist(i)).sum::<f64>() / (2.0 * PI)
+        (1..=self.segments())
+            .map(|i| self.vertex_twist(i))
+            .sum::<f64>()
+            / (2.0 * PI)
     }
 
     /// Material directors (d1, d2, d3) of edge j.

@@ -75,8 +75,8 @@ impl ShootingSolution {
     /// State at s by cubic Hermite interpolation with the exact derivative (A.2).
     pub fn at(&self, s: f64) -> OdeState {
         let steps = self.samples.len() - 1;
-        let x = (s.clamp(0.0, 1.0) * steps as f64).min(steps as f64 - 1e-12);
-        let k = x.floor() as usize;
+        let x = s.clamp(0.0, 1.0) * steps as f64;
+        let k = (x.floor() as usize).min(steps - 1);
         let t = x - k as f64;
         let ds = 1.0 / steps as f64;
         let (y0, y1) = (&self.samples[k], &self.samples[k + 1]);
@@ -115,7 +115,14 @@ impl ShootingSolution {
         let r = part(y, 0) - clamps.end_point();
         let d1 = part(y, 1);
         let d3 = part(y, 3);
-        Vector6::new(r[0], r[1], r[2], d3[0], d3[1], wrap(d1[1].atan2(d1[0]) - clamps.phi))
+        Vector6::new(
+            r[0],
+            r[1],
+            r[2],
+            d3[0],
+            d3[1],
+            wrap(d1[1].atan2(d1[0]) - clamps.phi),
+        )
     }
 }
 
@@ -132,8 +139,14 @@ pub fn refine_shooting(
 ) -> Option<(Vector3<f64>, Vector3<f64>)> {
     let mut p = Vector6::new(n0[0], n0[1], n0[2], m0[0], m0[1], m0[2]);
     let res = |p: &Vector6<f64>| {
-        ShootingSolution::integrate(p.fixed_rows::<3>(0).into(), p.fixed_rows::<3>(3).into(), k2, k3, steps)
-            .boundary_residual(clamps)
+        ShootingSolution::integrate(
+            p.fixed_rows::<3>(0).into(),
+            p.fixed_rows::<3>(3).into(),
+            k2,
+            k3,
+            steps,
+        )
+        .boundary_residual(clamps)
     };
     for _ in 0..30 {
         let r = res(&p);

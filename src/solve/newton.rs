@@ -10,7 +10,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct NewtonSettings {
-    /// Stop when ‖∇E‖ ≤ tol × (scale of the internal forces).
+    /// Stop when ‖∇E‖ ≤ tol × (scale of the internal forces), or when ‖∇E‖
+    /// reaches its round-off floor (ε × largest stiffness × extent × √n).
     pub gradient_tol: f64,
     /// Give up after this many iterations.
     pub max_iterations: usize,
@@ -49,7 +50,9 @@ pub struct NewtonReport {
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
     /// No convergence within the iteration budget.
-    #[error("Newton did not converge in {iterations} iterations (relative gradient {residual:.3e})")]
+    #[error(
+        "Newton did not converge in {iterations} iterations (relative gradient {residual:.3e})"
+    )]
     NotConverged {
         /// Iterations taken.
         iterations: usize,
@@ -65,7 +68,9 @@ pub enum SolveError {
         iteration: usize,
     },
     /// The line search could not decrease the energy.
-    #[error("line search failed at Newton iteration {iteration} (relative gradient {residual:.3e})")]
+    #[error(
+        "line search failed at Newton iteration {iteration} (relative gradient {residual:.3e})"
+    )]
     LineSearch {
         /// At which iteration.
         iteration: usize,
@@ -99,6 +104,15 @@ impl Newton {
             values: vec![0.0; nnz],
             step: vec![0.0; n],
         }
+    }
+
+    fn max_diagonal(&self) -> f64 {
+        self.energy
+            .pattern
+            .diagonal
+            .iter()
+            .map(|&s| self.values[s].abs())
+            .fold(0.0, f64::max)
     }
 
     /// Minimise the energy from `state` (updated in place).
@@ -135,7 +149,15 @@ impl Newton {
             report.gradient_norm = rel;
             report.energy = info.energy;
             report.iterations = it;
-            if rel <= settings.gradient_tol || gnorm < 1e-13 {
+            // the gradient is known only to round-off of the positions times the
+            // stiffness: below that floor no step can improve it
+            let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
+            let floor = 16.0
+                * f64::EPSILON
+                * self.max_diagonal()
+                * extent.max(1e-3)
+                * (self.grad.len() as f64).sqrt();
+            if rel <= settings.gradient_tol || gnorm <= floor {
                 report.converged = true;
                 return Ok(report);
             }
@@ -144,14 +166,7 @@ impl Newton {
             }
             // Newton direction with the smallest diagonal shift that makes the
             // Hessian positive definite (a descent direction for minimisation).
-            let diag_scale = self
-                .energy
-                .pattern
-                .diagonal
-                .iter()
-                .map(|&s| self.values[s].abs())
-                .fold(0.0, f64::max)
-                .max(1e-300);
+            let diag_scale = self.max_diagonal().max(1e-300);
             shift = (shift * 0.1).max(0.0);
             if shift < 1e-12 * diag_scale {
                 shift = 0.0;
@@ -168,7 +183,11 @@ impl Newton {
                 if ok {
                     break;
                 }
-                shift = if shift == 0.0 { 1e-8 * diag_scale } else { shift * 10.0 };
+                shift = if shift == 0.0 {
+                    1e-8 * diag_scale
+                } else {
+                    shift * 10.0
+                };
                 if shift > 1e6 * diag_scale {
                     return Err(SolveError::NonFinite {
                         step: "Hessian regularisation",

@@ -4,11 +4,11 @@
 use dyn_stack::{MemBuffer, MemStack};
 use faer::Par;
 use faer::linalg::cholesky::ldlt::factor::{LdltParams, LdltRegularization};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
-use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Side, Spec};
 use nalgebra_sparse::{CooMatrix, CscMatrix};
@@ -85,6 +85,17 @@ impl SymmetricPattern {
         self.matrix.nnz()
     }
 
+    /// Value slot of entry (r, c) (either triangle), if it is in the pattern.
+    pub fn slot(&self, r: usize, c: usize) -> Option<usize> {
+        let (r, c) = if r <= c { (r, c) } else { (c, r) };
+        let start = self.matrix.col_offsets()[c];
+        let end = self.matrix.col_offsets()[c + 1];
+        self.matrix.row_indices()[start..end]
+            .binary_search(&r)
+            .ok()
+            .map(|k| start + k)
+    }
+
     /// y = A x for the symmetric matrix with these upper-triangle values.
     pub fn mul_vec(&self, values: &[f64], x: &[f64], y: &mut [f64]) {
         y.iter_mut().for_each(|v| *v = 0.0);
@@ -130,7 +141,9 @@ pub struct Ldlt {
 
 impl std::fmt::Debug for Ldlt {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Ldlt").field("dim", &self.col_ptr.len().saturating_sub(1)).finish()
+        f.debug_struct("Ldlt")
+            .field("dim", &self.col_ptr.len().saturating_sub(1))
+            .finish()
     }
 }
 

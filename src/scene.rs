@@ -1,0 +1,372 @@
+//! Scene files (TOML): model, clamps, initial shape, solver settings, outputs.
+//! Every field is checked; errors name the field.
+
+use crate::model::rod::{Clamps, RodModel};
+use crate::solve::newton::NewtonSettings;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A scene as written in TOML.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Short name (defaults to the file stem).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Free text.
+    #[serde(default)]
+    pub description: Option<String>,
+    /// Rod model.
+    pub model: ModelSpec,
+    /// Clamp parameters.
+    pub clamps: ClampSpec,
+    /// Initial shape.
+    #[serde(default)]
+    pub initial: InitialSpec,
+    /// Newton settings.
+    #[serde(default)]
+    pub solver: NewtonSettings,
+    /// Stability settings.
+    #[serde(default)]
+    pub stability: StabilitySpec,
+    /// Published values to compare with (printed beside ours, never copied).
+    #[serde(default)]
+    pub reference: Option<ReferenceSpec>,
+    /// Outputs.
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+/// `[model]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// Model kind: only "kirchhoff" for now.
+    #[serde(default = "default_kind")]
+    pub kind: String,
+    /// B22/B11.
+    #[serde(rename = "K2", default = "default_k")]
+    pub k2: f64,
+    /// B33/B11.
+    #[serde(rename = "K3", default = "default_k")]
+    pub k3: f64,
+    /// Number of segments N.
+    #[serde(default = "default_segments")]
+    pub segments: i64,
+    /// Rod diameter h (sets the default stretching stiffness 16/h²).
+    #[serde(default = "default_diameter")]
+    pub rod_diameter: f64,
+    /// Stretching stiffness EA L²/B11 (overrides the one from the diameter).
+    #[serde(default)]
+    pub stretching_stiffness: Option<f64>,
+}
+
+fn default_kind() -> String {
+    "kirchhoff".into()
+}
+fn default_k() -> f64 {
+    3.0
+}
+fn default_segments() -> i64 {
+    200
+}
+fn default_diameter() -> f64 {
+    1.0 / 200.0
+}
+
+/// `[clamps]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClampSpec {
+    /// End displacement z*.
+    pub z_star: f64,
+    /// End shift δ (≥ 0).
+    #[serde(default)]
+    pub delta: f64,
+    /// End rotation φ/2π (continuous: 1.3 is one turn more than 0.3).
+    #[serde(default)]
+    pub phi_over_2pi: f64,
+}
+
+/// `[initial]`
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// "straight" (default), "shooting" or "file".
+    #[serde(default)]
+    pub shape: InitialShape,
+    /// Shooting data: n(0) in the material frame.
+    #[serde(default)]
+    pub n0: Option<[f64; 3]>,
+    /// Shooting data: m(0) in the material frame.
+    #[serde(default)]
+    pub m0: Option<[f64; 3]>,
+    /// Refine the shooting data by Newton on the s = 1 boundary conditions first.
+    #[serde(default)]
+    pub refine: bool,
+    /// RK4 steps for the shooting integration.
+    #[serde(default)]
+    pub steps: Option<i64>,
+    /// A previous run's JSON summary.
+    #[serde(default)]
+    pub file: Option<PathBuf>,
+    /// Which equilibrium of that file.
+    #[serde(default)]
+    pub index: usize,
+}
+
+/// Kinds of initial shape.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum InitialShape {
+    /// Straight from clamp to clamp, uniformly twisted by φ.
+    #[default]
+    Straight,
+    /// Integrate (A.2) from n(0), m(0).
+    Shooting,
+    /// A state from a previous run's JSON summary.
+    File,
+}
+
+/// `[stability]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct StabilitySpec {
+    /// How many lowest eigenvalues to compute (0: inertia only).
+    pub eigenvalues: i64,
+}
+
+impl Default for StabilitySpec {
+    fn default() -> Self {
+        StabilitySpec { eigenvalues: 4 }
+    }
+}
+
+/// `[reference]`: published values for comparison.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSpec {
+    /// Source, e.g. "paper Appendix D".
+    #[serde(default)]
+    pub source: Option<String>,
+    /// n(0).
+    #[serde(default)]
+    pub n0: Option<[f64; 3]>,
+    /// m(0).
+    #[serde(default)]
+    pub m0: Option<[f64; 3]>,
+    /// Tw.
+    #[serde(default)]
+    pub twist: Option<f64>,
+    /// Walled or not.
+    #[serde(default)]
+    pub walled: Option<bool>,
+    /// Stable or not.
+    #[serde(default)]
+    pub stable: Option<bool>,
+}
+
+/// `[output]`
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Where to write the JSON summary (the command line `--json` wins).
+    #[serde(default)]
+    pub json: Option<PathBuf>,
+}
+
+/// A scene that could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("cannot read scene {path}: {source}")]
+    Io {
+        /// Path.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// TOML syntax or an unknown/mistyped field.
+    #[error("scene {path}: {message}")]
+    Parse {
+        /// Path.
+        path: PathBuf,
+        /// The parser's message (names the field and line).
+        message: String,
+    },
+    /// A value out of its admissible range.
+    #[error("scene field `{field}`: {reason}")]
+    Invalid {
+        /// Dotted field name.
+        field: &'static str,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+fn invalid(field: &'static str, reason: impl Into<String>) -> SceneError {
+    SceneError::Invalid {
+        field,
+        reason: reason.into(),
+    }
+}
+
+fn finite(field: &'static str, v: f64) -> Result<f64, SceneError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(invalid(field, format!("must be a finite number, got {v}")))
+    }
+}
+
+fn positive(field: &'static str, v: f64) -> Result<f64, SceneError> {
+    finite(field, v)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(field, format!("must be > 0, got {v}")))
+    }
+}
+
+impl Scene {
+    /// Read and validate a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.into(),
+            source,
+        })?;
+        let mut scene = Scene::parse(&text).map_err(|e| match e {
+            SceneError::Parse { message, .. } => SceneError::Parse {
+                path: path.into(),
+                message,
+            },
+            other => other,
+        })?;
+        if scene.name.is_none() {
+            scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+        }
+        // relative initial files are relative to the scene's folder
+        if let Some(f) = &scene.initial.file {
+            if f.is_relative() && !f.exists() {
+                if let Some(dir) = path.parent() {
+                    scene.initial.file = Some(dir.join(f));
+                }
+            }
+        }
+        Ok(scene)
+    }
+
+    /// Parse and validate scene text.
+    pub fn parse(text: &str) -> Result<Scene, SceneError> {
+        let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
+            path: PathBuf::from("<text>"),
+            message: e.to_string(),
+        })?;
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// Check every value's range.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let m = &self.model;
+        if m.kind != "kirchhoff" {
+            return Err(invalid(
+                "model.kind",
+                format!("unknown model `{}` (known: kirchhoff)", m.kind),
+            ));
+        }
+        positive("model.K2", m.k2)?;
+        positive("model.K3", m.k3)?;
+        if m.segments < 4 || m.segments > 1_000_000 {
+            return Err(invalid(
+                "model.segments",
+                format!("must be an integer in 4..=1000000, got {}", m.segments),
+            ));
+        }
+        positive("model.rod_diameter", m.rod_diameter)?;
+        if let Some(s) = m.stretching_stiffness {
+            positive("model.stretching_stiffness", s)?;
+        }
+        let c = &self.clamps;
+        finite("clamps.z_star", c.z_star)?;
+        finite("clamps.delta", c.delta)?;
+        finite("clamps.phi_over_2pi", c.phi_over_2pi)?;
+        if c.delta < 0.0 {
+            return Err(invalid(
+                "clamps.delta",
+                format!("must be >= 0, got {}", c.delta),
+            ));
+        }
+        if c.z_star.abs() > 1.0 {
+            return Err(invalid(
+                "clamps.z_star",
+                format!("|z*| must be <= 1 (the rod has length 1), got {}", c.z_star),
+            ));
+        }
+        if (c.z_star * c.z_star + c.delta * c.delta).sqrt() > 1.0 {
+            return Err(invalid(
+                "clamps.delta",
+                "the clamps are farther apart than the rod's length: sqrt(z*² + δ²) > 1",
+            ));
+        }
+        let i = &self.initial;
+        if i.shape == InitialShape::Shooting {
+            let n0 =
+                i.n0.ok_or_else(|| invalid("initial.n0", "required for shape = \"shooting\""))?;
+            let m0 =
+                i.m0.ok_or_else(|| invalid("initial.m0", "required for shape = \"shooting\""))?;
+            for v in n0 {
+                finite("initial.n0", v)?;
+            }
+            for v in m0 {
+                finite("initial.m0", v)?;
+            }
+        }
+        if let Some(s) = i.steps {
+            if !(10..=10_000_000).contains(&s) {
+                return Err(invalid(
+                    "initial.steps",
+                    format!("must be in 10..=10000000, got {s}"),
+                ));
+            }
+        }
+        if i.shape == InitialShape::File && i.file.is_none() {
+            return Err(invalid("initial.file", "required for shape = \"file\""));
+        }
+        let s = &self.solver;
+        positive("solver.gradient_tol", s.gradient_tol)?;
+        positive("solver.max_step", s.max_step)?;
+        if s.max_iterations == 0 {
+            return Err(invalid("solver.max_iterations", "must be >= 1"));
+        }
+        if self.stability.eigenvalues < 0 || self.stability.eigenvalues > 100 {
+            return Err(invalid(
+                "stability.eigenvalues",
+                format!("must be in 0..=100, got {}", self.stability.eigenvalues),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The rod model (with N replaced if `segments` is given).
+    pub fn rod_model(&self, segments: Option<usize>) -> RodModel {
+        let m = &self.model;
+        RodModel {
+            segments: segments.unwrap_or(m.segments as usize),
+            k2: m.k2,
+            k3: m.k3,
+            stretching_stiffness: m
+                .stretching_stiffness
+                .unwrap_or_else(|| RodModel::circular_stretching_stiffness(m.rod_diameter)),
+        }
+    }
+
+    /// The clamps.
+    pub fn clamps(&self) -> Clamps {
+        Clamps::new(
+            self.clamps.z_star,
+            self.clamps.delta,
+            self.clamps.phi_over_2pi,
+        )
+    }
+}

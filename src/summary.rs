@@ -1,0 +1,169 @@
+//! The machine-readable run summary (JSON) and its human-readable print.
+
+use crate::equilibrium::Equilibrium;
+use crate::model::rod::RodModel;
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::Path;
+
+/// The model as written in summaries.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ModelSummary {
+    /// Model kind.
+    pub kind: String,
+    /// B22/B11.
+    #[serde(rename = "K2")]
+    pub k2: f64,
+    /// B33/B11.
+    #[serde(rename = "K3")]
+    pub k3: f64,
+    /// Stretching stiffness.
+    pub stretching_stiffness: f64,
+}
+
+/// A run's summary: `{"scene", "model", "segments", "equilibria", "events"}`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Summary {
+    /// Scene name.
+    pub scene: String,
+    /// Model parameters.
+    pub model: ModelSummary,
+    /// N.
+    pub segments: usize,
+    /// Equilibria in the order computed.
+    pub equilibria: Vec<Equilibrium>,
+    /// Located events (filled by continuation runs).
+    pub events: Vec<serde_json::Value>,
+}
+
+impl Summary {
+    /// An empty summary for a scene and model.
+    pub fn new(scene: &Scene, model: &RodModel) -> Self {
+        Summary {
+            scene: scene.name.clone().unwrap_or_default(),
+            model: ModelSummary {
+                kind: scene.model.kind.clone(),
+                k2: model.k2,
+                k3: model.k3,
+                stretching_stiffness: model.stretching_stiffness,
+            },
+            segments: model.segments,
+            equilibria: Vec::new(),
+            events: Vec::new(),
+        }
+    }
+
+    /// Write as JSON (to a temporary file renamed into place, so a reader never
+    /// sees a half-written summary).
+    pub fn write(&self, path: &Path) -> anyhow::Result<()> {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)?;
+        }
+        let tmp = path.with_extension("json.tmp");
+        let mut f = std::fs::File::create(&tmp)?;
+        serde_json::to_writer_pretty(&mut f, self)?;
+        f.write_all(b"\n")?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)?;
+        Ok(())
+    }
+}
+
+fn vec3(v: &[f64; 3]) -> String {
+    format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2])
+}
+
+fn relative_deviation(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let d: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt();
+    d / b.iter().map(|y| y * y).sum::<f64>().sqrt()
+}
+
+/// Human-readable report of one equilibrium, with the scene's published
+/// reference values (if any) and our deviation from them.
+pub fn print_equilibrium(
+    e: &Equilibrium,
+    scene: &Scene,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "equilibrium at z* = {:.4}, δ = {:.4}, φ/2π = {:.4}",
+        e.z_star, e.delta, e.phi_over_2pi
+    )?;
+    writeln!(
+        out,
+        "  Newton: {} in {} iterations, relative gradient {:.2e}",
+        if e.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        e.iterations,
+        e.gradient_norm
+    )?;
+    writeln!(out, "  energy E = {:.6}", e.energy)?;
+    writeln!(out, "  n(0) = {}", vec3(&e.n0))?;
+    writeln!(out, "  m(0) = {}", vec3(&e.m0))?;
+    writeln!(out, "  twist Tw = {:.5}", e.twist)?;
+    writeln!(
+        out,
+        "  z range ({:.5}, {:.5}) — {}",
+        e.min_z,
+        e.max_z,
+        if e.walled { "walled" } else { "not walled" }
+    )?;
+    writeln!(
+        out,
+        "  {} ({} negative eigenvalues); lowest ω² = {:?}",
+        if e.stable { "stable" } else { "UNSTABLE" },
+        e.negative_eigenvalues,
+        e.omega_squared
+            .iter()
+            .map(|v| format!("{v:.4}"))
+            .collect::<Vec<_>>()
+    )?;
+    if let Some(r) = &scene.reference {
+        let src = r.source.as_deref().unwrap_or("reference");
+        writeln!(out, "  compared with {src}:")?;
+        if let Some(n0) = &r.n0 {
+            writeln!(
+                out,
+                "    n(0) {}: relative deviation {:.3}%",
+                vec3(n0),
+                100.0 * relative_deviation(&e.n0, n0)
+            )?;
+        }
+        if let Some(m0) = &r.m0 {
+            writeln!(
+                out,
+                "    m(0) {}: relative deviation {:.3}%",
+                vec3(m0),
+                100.0 * relative_deviation(&e.m0, m0)
+            )?;
+        }
+        if let Some(tw) = r.twist {
+            writeln!(out, "    Tw {tw}: difference {:+.4}", e.twist - tw)?;
+        }
+        if let Some(w) = r.walled {
+            writeln!(
+                out,
+                "    walled {w}: {}",
+                if w == e.walled { "agrees" } else { "DISAGREES" }
+            )?;
+        }
+        if let Some(s) = r.stable {
+            writeln!(
+                out,
+                "    stable {s}: {}",
+                if s == e.stable { "agrees" } else { "DISAGREES" }
+            )?;
+        }
+    }
+    Ok(())
+}
