@@ -1,6 +1,7 @@
 //! knotrod: equilibria, stability and knot diagnostics of clamped elastic rods
 //! (discrete elastic rods), after "Stable elastic knots with no self-contact".
 
+pub mod analytic;
 pub mod cli;
 pub mod equilibrium;
 pub mod model;
@@ -8,3 +9,4 @@ pub mod scene;
 pub mod solve;
 pub mod stability;
 pub mod summary;
+pub mod validation;

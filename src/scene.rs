@@ -246,12 +246,12 @@ impl Scene {
             scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned());
         }
         // relative initial files are relative to the scene's folder
-        if let Some(f) = &scene.initial.file {
-            if f.is_relative() && !f.exists() {
-                if let Some(dir) = path.parent() {
-                    scene.initial.file = Some(dir.join(f));
-                }
-            }
+        if let Some(f) = &scene.initial.file
+            && f.is_relative()
+            && !f.exists()
+            && let Some(dir) = path.parent()
+        {
+            scene.initial.file = Some(dir.join(f));
         }
         Ok(scene)
     }
@@ -322,13 +322,13 @@ impl Scene {
                 finite("initial.m0", v)?;
             }
         }
-        if let Some(s) = i.steps {
-            if !(10..=10_000_000).contains(&s) {
-                return Err(invalid(
-                    "initial.steps",
-                    format!("must be in 10..=10000000, got {s}"),
-                ));
-            }
+        if let Some(s) = i.steps
+            && !(10..=10_000_000).contains(&s)
+        {
+            return Err(invalid(
+                "initial.steps",
+                format!("must be in 10..=10000000, got {s}"),
+            ));
         }
         if i.shape == InitialShape::File && i.file.is_none() {
             return Err(invalid("initial.file", "required for shape = \"file\""));

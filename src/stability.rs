@@ -211,30 +211,51 @@ pub fn lowest_eigenvalues(
         weight: &weight,
         full_dim: n,
     };
-    let params = PartialEigenParams {
-        max_dim: (4 * k).max(40).min(dim),
-        ..Default::default()
+    let mu: Vec<f64> = if dim <= 128 {
+        // small problems: the operator as a dense matrix (faer's Lanczos needs
+        // a subspace smaller than the space)
+        let mut a = Mat::<f64>::zeros(dim, dim);
+        op.apply(
+            a.as_mut(),
+            Mat::<f64>::identity(dim, dim).as_ref(),
+            Par::Seq,
+            MemStack::new(&mut MemBuffer::new(dyn_stack::StackReq::EMPTY)),
+        );
+        let a = Mat::<f64>::from_fn(dim, dim, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+        let evd = a
+            .self_adjoint_eigen(faer::Side::Lower)
+            .map_err(|_| StabilityError::NonFinite)?;
+        let mut all: Vec<f64> = (0..dim).map(|i| evd.S()[i]).collect();
+        all.sort_by(|x, y| y.total_cmp(x));
+        all.truncate(k);
+        all
+    } else {
+        let params = PartialEigenParams {
+            max_dim: (4 * k).max(80),
+            ..Default::default()
+        };
+        let mut buf = MemBuffer::new(partial_self_adjoint_eigen_scratch::<f64>(
+            &op,
+            k,
+            Par::Seq,
+            params,
+        ));
+        let mut vecs = Mat::<f64>::zeros(dim, k);
+        let mut mu = vec![0.0; k];
+        // deterministic start vector with components on every mode
+        let v0 = Col::<f64>::from_fn(dim, |i| 1.0 + 0.5 * ((i as f64) * 0.7548776662).sin());
+        partial_self_adjoint_eigen(
+            vecs.as_mut(),
+            &mut mu,
+            &op,
+            v0.as_ref(),
+            1e-12,
+            Par::Seq,
+            MemStack::new(&mut buf),
+            params,
+        );
+        mu
     };
-    let mut buf = MemBuffer::new(partial_self_adjoint_eigen_scratch::<f64>(
-        &op,
-        k,
-        Par::Seq,
-        params,
-    ));
-    let mut vecs = Mat::<f64>::zeros(dim, k);
-    let mut mu = vec![0.0; k];
-    // deterministic start vector with components on every mode
-    let v0 = Col::<f64>::from_fn(dim, |i| 1.0 + 0.5 * ((i as f64) * 0.7548776662).sin());
-    partial_self_adjoint_eigen(
-        vecs.as_mut(),
-        &mut mu,
-        &op,
-        v0.as_ref(),
-        1e-12,
-        Par::Seq,
-        MemStack::new(&mut buf),
-        params,
-    );
     let mut lambda: Vec<f64> = mu
         .iter()
         .filter(|m| **m != 0.0)

@@ -74,7 +74,8 @@ fn vec3(v: &[f64; 3]) -> String {
     format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2])
 }
 
-fn relative_deviation(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+/// ‖a − b‖ / ‖b‖ for 3-vectors.
+pub fn relative_deviation(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     let d: f64 = a
         .iter()
         .zip(b)

@@ -85,10 +85,10 @@ mod tests {
 
     #[test]
     fn transport_maps_frame_to_frame() {
-        let t = [0.0, 0.0, 1.0];
-        let a = [1.0, 0.0, 0.0];
+        let t: [f64; 3] = [0.0, 0.0, 1.0];
+        let a: [f64; 3] = [1.0, 0.0, 0.0];
         let tn = {
-            let v = [0.3, -0.4, 0.8];
+            let v: [f64; 3] = [0.3, -0.4, 0.8];
             let n = norm(v);
             scale(1.0 / n, v)
         };

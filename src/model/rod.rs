@@ -132,7 +132,7 @@ impl DofMap {
 
     /// Whether dof `d` is a translational one (a node coordinate).
     pub fn is_translation(&self, d: usize) -> bool {
-        d % 4 != 0
+        !d.is_multiple_of(4)
     }
 }
 
@@ -288,7 +288,6 @@ impl RodState {
     /// this state's tangents and continue the reference twist.
     pub fn update_frames_from(&mut self, old: &RodState) {
         let n = self.segments();
-        let mut t_prev_old = tangent(&old.nodes, 0);
         let mut t_prev = tangent(&self.nodes, 0);
         self.reference[0] = old.reference[0];
         for j in 1..=n {
@@ -303,10 +302,8 @@ impl RodState {
                 &t,
                 old.reference_twist[j],
             );
-            t_prev_old = t_old;
             t_prev = t;
         }
-        let _ = t_prev_old;
     }
 
     /// Twist at vertex i: θ_i - θ_{i-1} + reference twist.
