@@ -6,6 +6,7 @@ use crate::summary::{Summary, print_equilibrium};
 use crate::validation;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// knotrod: equilibria and stability of clamped elastic rods.
@@ -57,7 +58,7 @@ pub fn main_with(cli: Cli) -> Result<()> {
         } => run(&scene, json, segments),
         Command::Convergence { scene, segments } => convergence(&scene, &segments),
         Command::Validate { scenes } => {
-            print!("{}", validation::report(&scenes)?);
+            write!(std::io::stdout().lock(), "{}", validation::report(&scenes)?)?;
             Ok(())
         }
     }
@@ -75,27 +76,33 @@ fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()
     let start = std::time::Instant::now();
     let eq = solve_scene(&scene, segments)?;
     let mut summary = Summary::new(&scene, &model);
-    println!(
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
         "scene {} — Kirchhoff rod, K2 = {}, K3 = {}, N = {} ({:.2} s)",
         summary.scene,
         model.k2,
         model.k3,
         model.segments,
         start.elapsed().as_secs_f64()
-    );
-    print_equilibrium(&eq, &scene, &mut std::io::stdout())?;
+    )?;
+    print_equilibrium(&eq, &scene, &mut out)?;
     summary.equilibria.push(eq);
-    if let Some(out) = json.or(scene.output.json.clone()) {
+    if let Some(path) = json.or(scene.output.json.clone()) {
         summary
-            .write(&out)
-            .with_context(|| format!("writing {}", out.display()))?;
-        println!("summary written to {}", out.display());
+            .write(&path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        writeln!(out, "summary written to {}", path.display())?;
     }
     Ok(())
 }
 
 fn convergence(path: &Path, segments: &[usize]) -> Result<()> {
     let scene = Scene::load(path)?;
-    print!("{}", validation::convergence_table(&scene, segments)?);
+    write!(
+        std::io::stdout().lock(),
+        "{}",
+        validation::convergence_table(&scene, segments)?
+    )?;
     Ok(())
 }

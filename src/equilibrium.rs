@@ -1,6 +1,11 @@
 //! One equilibrium of a scene: initial shape, Newton solve, and the quantities
 //! the paper reports (clamp reactions, twist, walls, stability).
 
+use crate::geometry::closure::{extent, ray_closure};
+use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
+use crate::geometry::knot::{KnotType, knot_type};
+use crate::geometry::walls::wall_clearance;
+use crate::geometry::writhe::writhe_closed;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
@@ -50,6 +55,28 @@ pub struct Equilibrium {
     pub negative_eigenvalues: usize,
     /// All eigenvalues positive.
     pub stable: bool,
+    /// Writhe of the ray-closed centreline.
+    pub writhe: f64,
+    /// Tw + writhe (for walled configurations the paper's Tw + polar writhe).
+    pub link: f64,
+    /// |Δ(−1)| of the ray closure (3: trefoil).
+    pub knot_determinant: u64,
+    /// Alexander polynomial of the ray closure, lowest degree first.
+    pub alexander: Vec<i64>,
+    /// A knot with that polynomial.
+    pub knot_name: Option<String>,
+    /// The knot type's projections disagreed.
+    pub knot_ambiguous: bool,
+    /// Smallest distance between parts of the centreline at least the gap apart.
+    pub min_self_distance: f64,
+    /// Arc lengths (s, s') of that closest approach.
+    pub min_self_distance_s: [f64; 2],
+    /// Clearance of the interior extrema of z from the walls (negative: outside).
+    pub wall_distance: f64,
+    /// Smallest distance to the clamps' rays (bottom, top), away from the clamps.
+    pub ray_distance: [f64; 2],
+    /// Walled, trefoil, stable and no closer to itself than the rod diameter.
+    pub good_knot: bool,
     /// The full discrete state (restart with `[initial] shape = "file"`).
     pub state: RodState,
 }
@@ -109,13 +136,82 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
     })
 }
 
+/// Settings of the measurements of an equilibrium.
+#[derive(Clone, Copy, Debug)]
+pub struct Measure {
+    /// Lowest eigenvalues to compute.
+    pub eigenvalues: usize,
+    /// Rod diameter (self-distance threshold of a good knot).
+    pub rod_diameter: f64,
+    /// Arc-length gap of the self-distance.
+    pub self_distance_gap: f64,
+    /// Ray length of the writhe closure.
+    pub ray_length: f64,
+}
+
+impl Measure {
+    /// The measurement settings of a scene.
+    pub fn of(scene: &Scene) -> Self {
+        Measure {
+            eigenvalues: scene.stability.eigenvalues as usize,
+            rod_diameter: scene.model.rod_diameter,
+            self_distance_gap: scene.diagnostics.self_distance_gap,
+            ray_length: scene.diagnostics.ray_length,
+        }
+    }
+}
+
+/// Writhe, knot type, walls and distances of a state (see [`Equilibrium`]).
+pub struct Shape {
+    /// Writhe of the ray closure.
+    pub writhe: f64,
+    /// Knot type of the ray closure.
+    pub knot: KnotType,
+    /// Closest self-approach.
+    pub self_approach: Option<Approach>,
+    /// Wall clearance.
+    pub wall_distance: f64,
+    /// Distances to the bottom and top rays.
+    pub ray_distance: [f64; 2],
+}
+
+impl Shape {
+    /// Measure the centreline of `state`.
+    pub fn of(state: &RodState, measure: &Measure) -> Shape {
+        let (points, arc) = state.centreline();
+        let e3 = Vector3::z();
+        let writhe = writhe_closed(&ray_closure(&points, -e3, e3, measure.ray_length));
+        // the knot type needs the rays only to leave the curve's neighbourhood
+        let reach = 2.0 * extent(&points) + 1.0;
+        let knot = knot_type(&ray_closure(&points, -e3, e3, reach));
+        let self_approach = min_self_distance(&points, &arc, measure.self_distance_gap);
+        let heights: Vec<f64> = points[1..points.len() - 1].iter().map(|p| p.z).collect();
+        let wall_distance = wall_clearance(&heights, state.clamps.z_star);
+        let end = *points.last().unwrap();
+        let gap = measure.self_distance_gap;
+        let ray = |origin: &Vector3<f64>, dir: Vector3<f64>, s_base: f64| {
+            distance_to_ray(&points, &arc, origin, &dir, reach, s_base, gap)
+                .map_or(f64::INFINITY, |d| d.0)
+        };
+        let ray_distance = [ray(&Vector3::zeros(), -e3, 0.0), ray(&end, e3, 1.0)];
+        Shape {
+            writhe,
+            knot,
+            self_approach,
+            wall_distance,
+            ray_distance,
+        }
+    }
+}
+
 /// Measure an equilibrium found by `newton` (its energy is reused for the Hessian).
 pub fn analyse(
     newton: &mut Newton,
     state: &RodState,
     report: &NewtonReport,
-    k: usize,
+    measure: &Measure,
 ) -> Result<Equilibrium> {
+    let k = measure.eigenvalues;
     let energy: &RodEnergy = &newton.energy;
     let n = energy.map.len();
     let mut grad = vec![0.0; n];
@@ -130,6 +226,10 @@ pub fn analyse(
     let (min_z, max_z) = state.z_range();
     let z_star = state.clamps.z_star;
     let stable = plain.negative_count == 0 && plain.values.first().is_none_or(|v| *v > 0.0);
+    let shape = Shape::of(state, measure);
+    let twist = state.twist();
+    let walled = min_z > 0.0 && max_z < z_star;
+    let min_self_distance = shape.self_approach.map_or(f64::INFINITY, |a| a.distance);
     Ok(Equilibrium {
         z_star,
         delta: state.clamps.delta,
@@ -141,14 +241,29 @@ pub fn analyse(
         energy: report.energy,
         n0: reactions.force.into(),
         m0: reactions.moment.into(),
-        twist: state.twist(),
+        twist,
         min_z,
         max_z,
-        walled: min_z > 0.0 && max_z < z_star,
+        walled,
         lowest_eigenvalues: plain.values,
         omega_squared: pencil.values,
         negative_eigenvalues: plain.negative_count,
         stable,
+        writhe: shape.writhe,
+        link: twist + shape.writhe,
+        knot_determinant: shape.knot.determinant,
+        good_knot: walled
+            && shape.knot.determinant == 3
+            && !shape.knot.ambiguous
+            && stable
+            && min_self_distance > measure.rod_diameter,
+        alexander: shape.knot.alexander,
+        knot_name: shape.knot.name,
+        knot_ambiguous: shape.knot.ambiguous,
+        min_self_distance,
+        min_self_distance_s: shape.self_approach.map_or([f64::NAN; 2], |a| a.s),
+        wall_distance: shape.wall_distance,
+        ray_distance: shape.ray_distance,
         state: state.clone(),
     })
 }
@@ -161,10 +276,5 @@ pub fn solve_scene(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium
     let report = newton
         .minimize(&mut state, &scene.solver)
         .context("Newton minimisation")?;
-    analyse(
-        &mut newton,
-        &state,
-        &report,
-        scene.stability.eigenvalues as usize,
-    )
+    analyse(&mut newton, &state, &report, &Measure::of(scene))
 }

@@ -4,6 +4,7 @@
 pub mod analytic;
 pub mod cli;
 pub mod equilibrium;
+pub mod geometry;
 pub mod model;
 pub mod scene;
 pub mod solve;

@@ -29,6 +29,9 @@ pub struct Scene {
     /// Stability settings.
     #[serde(default)]
     pub stability: StabilitySpec,
+    /// Knot diagnostics settings.
+    #[serde(default)]
+    pub diagnostics: DiagnosticsSpec,
     /// Published values to compare with (printed beside ours, never copied).
     #[serde(default)]
     pub reference: Option<ReferenceSpec>,
@@ -142,6 +145,25 @@ impl Default for StabilitySpec {
     }
 }
 
+/// `[diagnostics]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DiagnosticsSpec {
+    /// Self-distance ignores pairs of points closer than this along the rod.
+    pub self_distance_gap: f64,
+    /// Length of the rays closing the curve for the writhe (its error ∝ 1/length).
+    pub ray_length: f64,
+}
+
+impl Default for DiagnosticsSpec {
+    fn default() -> Self {
+        DiagnosticsSpec {
+            self_distance_gap: 0.05,
+            ray_length: 1e6,
+        }
+    }
+}
+
 /// `[reference]`: published values for comparison.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -158,6 +180,12 @@ pub struct ReferenceSpec {
     /// Tw.
     #[serde(default)]
     pub twist: Option<f64>,
+    /// Link Tw + Wp*.
+    #[serde(default)]
+    pub link: Option<f64>,
+    /// Knot determinant.
+    #[serde(default)]
+    pub knot_determinant: Option<u64>,
     /// Walled or not.
     #[serde(default)]
     pub walled: Option<bool>,
@@ -339,6 +367,15 @@ impl Scene {
         if s.max_iterations == 0 {
             return Err(invalid("solver.max_iterations", "must be >= 1"));
         }
+        let d = &self.diagnostics;
+        positive("diagnostics.self_distance_gap", d.self_distance_gap)?;
+        if d.self_distance_gap >= 0.5 {
+            return Err(invalid(
+                "diagnostics.self_distance_gap",
+                "must be < 0.5 (half the rod)",
+            ));
+        }
+        positive("diagnostics.ray_length", d.ray_length)?;
         if self.stability.eigenvalues < 0 || self.stability.eigenvalues > 100 {
             return Err(invalid(
                 "stability.eigenvalues",

@@ -129,6 +129,37 @@ pub fn print_equilibrium(
             .map(|v| format!("{v:.4}"))
             .collect::<Vec<_>>()
     )?;
+    writeln!(
+        out,
+        "  writhe Wr = {:.5} (ray closure), link Tw + Wr = {:.5}",
+        e.writhe, e.link
+    )?;
+    writeln!(
+        out,
+        "  knot: determinant {}, Alexander {:?}{}{}",
+        e.knot_determinant,
+        e.alexander,
+        e.knot_name
+            .as_deref()
+            .map(|n| format!(" — {n}"))
+            .unwrap_or_default(),
+        if e.knot_ambiguous { " (AMBIGUOUS)" } else { "" }
+    )?;
+    writeln!(
+        out,
+        "  min self-distance {:.5} at s = ({:.4}, {:.4}); wall clearance {:.5}; ray distance ({:.5}, {:.5})",
+        e.min_self_distance,
+        e.min_self_distance_s[0],
+        e.min_self_distance_s[1],
+        e.wall_distance,
+        e.ray_distance[0],
+        e.ray_distance[1]
+    )?;
+    writeln!(
+        out,
+        "  good knot: {}",
+        if e.good_knot { "YES" } else { "no" }
+    )?;
     if let Some(r) = &scene.reference {
         let src = r.source.as_deref().unwrap_or("reference");
         writeln!(out, "  compared with {src}:")?;
@@ -150,6 +181,20 @@ pub fn print_equilibrium(
         }
         if let Some(tw) = r.twist {
             writeln!(out, "    Tw {tw}: difference {:+.4}", e.twist - tw)?;
+        }
+        if let Some(l) = r.link {
+            writeln!(out, "    link {l}: difference {:+.4}", e.link - l)?;
+        }
+        if let Some(d) = r.knot_determinant {
+            writeln!(
+                out,
+                "    knot determinant {d}: {}",
+                if d == e.knot_determinant {
+                    "agrees"
+                } else {
+                    "DISAGREES"
+                }
+            )?;
         }
         if let Some(w) = r.walled {
             writeln!(

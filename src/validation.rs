@@ -195,6 +195,28 @@ fn paper_table(scene: &Scene, n: usize) -> Result<String> {
     if let Some(tw) = r.twist {
         writeln!(s, "| Tw | {:.4} | {tw} | {:+.4} |", e.twist, e.twist - tw)?;
     }
+    if let Some(l) = r.link {
+        writeln!(
+            s,
+            "| link Tw + Wr | {:.4} (Wr = {:.4}) | {l} | {:+.4} |",
+            e.link,
+            e.writhe,
+            e.link - l
+        )?;
+    }
+    if let Some(d) = r.knot_determinant {
+        writeln!(
+            s,
+            "| knot determinant | {} ({}) | {d} | |",
+            e.knot_determinant,
+            e.knot_name.as_deref().unwrap_or("?")
+        )?;
+    }
+    writeln!(
+        s,
+        "| min self-distance | {:.4} at s = ({:.3}, {:.3}) | > 0 (contact-free) | |",
+        e.min_self_distance, e.min_self_distance_s[0], e.min_self_distance_s[1]
+    )?;
     if let Some(w) = r.walled {
         writeln!(
             s,

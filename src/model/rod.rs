@@ -365,3 +365,23 @@ fn reference_twist_fresh(nodes: &[Vector3<f64>], reference: &[Vector3<f64>], i: 
 pub fn wrap(a: f64) -> f64 {
     a - 2.0 * PI * (a / (2.0 * PI)).round()
 }
+
+impl RodState {
+    /// The centreline as a polyline from r(0) = 0 to r(1) = (x*, y*, z*): the
+    /// clamp end points and the nodes 1..=N between them, with arc lengths.
+    pub fn centreline(&self) -> (Vec<Vector3<f64>>, Vec<f64>) {
+        let n = self.segments();
+        let h = 1.0 / n as f64;
+        let mut points = Vec::with_capacity(n + 2);
+        let mut arc = Vec::with_capacity(n + 2);
+        points.push(Vector3::zeros());
+        arc.push(0.0);
+        for i in 1..=n {
+            points.push(self.nodes[i]);
+            arc.push((i as f64 - 0.5) * h);
+        }
+        points.push(self.clamps.end_point());
+        arc.push(1.0);
+        (points, arc)
+    }
+}

@@ -1,0 +1,42 @@
+//! The closed curve the paper uses: the rod extended from s = 0 along −e3 and
+//! from s = 1 along +e3 by straight rays, joined by a loop far away.
+
+use nalgebra::Vector3;
+
+/// Ray closure of an open polyline whose first point is the s = 0 end and last
+/// point the s = 1 end: rays of length `ray` along `bottom_dir` from the first
+/// point and `top_dir` from the last, then a rectangle `ray` away to the side.
+pub fn ray_closure(
+    points: &[Vector3<f64>],
+    bottom_dir: Vector3<f64>,
+    top_dir: Vector3<f64>,
+    ray: f64,
+) -> Vec<Vector3<f64>> {
+    let first = points[0];
+    let last = *points.last().unwrap();
+    let bottom = first + ray * bottom_dir.normalize();
+    let top = last + ray * top_dir.normalize();
+    // a side direction perpendicular to the mean ray axis
+    let axis = (top_dir.normalize() - bottom_dir.normalize()).normalize();
+    let trial = if axis.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let side = (trial - trial.dot(&axis) * axis).normalize();
+    let mut closed = points.to_vec();
+    closed.push(top);
+    closed.push(top + ray * side);
+    closed.push(bottom + ray * side);
+    closed.push(bottom);
+    closed
+}
+
+/// Largest distance of the polyline's points from its first point: sets the
+/// ray length needed for a closure far from the curve.
+pub fn extent(points: &[Vector3<f64>]) -> f64 {
+    points
+        .iter()
+        .map(|p| (p - points[0]).norm())
+        .fold(0.0, f64::max)
+}

@@ -1,0 +1,34 @@
+//! The walls z = 0 and z = z* between which a walled configuration lies.
+
+/// Clearance from the walls: the smallest distance of an interior local
+/// minimum of z above z = 0 and of an interior local maximum below z = z*
+/// (negative when outside). The clamped ends, which start on the walls, do not
+/// count; `heights` are the interior node heights in order along the rod.
+pub fn wall_clearance(heights: &[f64], z_star: f64) -> f64 {
+    let n = heights.len();
+    let mut clearance = f64::INFINITY;
+    for i in 1..n.saturating_sub(1) {
+        let (a, z, b) = (heights[i - 1], heights[i], heights[i + 1]);
+        if z <= a && z <= b {
+            clearance = clearance.min(z);
+        }
+        if z >= a && z >= b {
+            clearance = clearance.min(z_star - z);
+        }
+    }
+    clearance
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clearance_sees_dips_and_bumps_but_not_the_ends() {
+        // rises from the bottom wall, dips to 0.02, bumps to 0.09, ends at the top
+        let z = [0.001, 0.05, 0.02, 0.06, 0.09, 0.07, 0.099];
+        assert!((wall_clearance(&z, 0.1) - 0.01).abs() < 1e-15);
+        let z = [0.001, 0.05, -0.02, 0.06, 0.099];
+        assert!((wall_clearance(&z, 0.1) + 0.02).abs() < 1e-15);
+    }
+}

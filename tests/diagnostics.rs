@@ -1,0 +1,89 @@
+//! Knot diagnostics of the paper's equilibria, self-distance against brute
+//! force, and the convergence of the writhe as the closing rays grow.
+
+use knotrod::equilibrium::solve_scene;
+use knotrod::geometry::closure::ray_closure;
+use knotrod::geometry::distance::{min_self_distance, min_self_distance_brute};
+use knotrod::geometry::writhe::writhe_closed;
+use knotrod::scene::Scene;
+use nalgebra::Vector3;
+use std::path::Path;
+
+#[test]
+fn appendix_d_is_a_good_knot_with_the_papers_link() {
+    let scene = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
+    let e = solve_scene(&scene, Some(200)).unwrap();
+    assert_eq!(e.knot_determinant, 3);
+    assert_eq!(e.alexander, vec![1, -1, 1]);
+    assert!(!e.knot_ambiguous);
+    assert!((e.link - 3.802).abs() < 0.02, "link {}", e.link);
+    assert!(e.walled && e.wall_distance > 0.0);
+    assert!(e.min_self_distance > 0.005, "{}", e.min_self_distance);
+    assert!(e.good_knot);
+}
+
+#[test]
+fn appendix_e_is_knotted_but_not_walled() {
+    let scene = Scene::load(Path::new("scenes/appendix_e.toml")).unwrap();
+    let e = solve_scene(&scene, Some(200)).unwrap();
+    assert_eq!(e.knot_determinant, 3);
+    assert!((e.link - 3.784).abs() < 0.02, "link {}", e.link);
+    assert!(!e.walled && e.wall_distance < 0.0);
+    assert!(!e.good_knot);
+}
+
+#[test]
+fn writhe_of_the_ray_closure_converges_as_one_over_ray_length() {
+    let scene = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
+    let e = solve_scene(&scene, Some(100)).unwrap();
+    let (p, _) = e.state.centreline();
+    let w: Vec<f64> = [1e1, 1e2, 1e3, 1e4]
+        .iter()
+        .map(|&r| writhe_closed(&ray_closure(&p, -Vector3::z(), Vector3::z(), r)))
+        .collect();
+    for k in 1..3 {
+        let ratio = (w[k] - w[k - 1]) / (w[k + 1] - w[k]);
+        assert!(
+            (ratio - 10.0).abs() < 1.0,
+            "error ratio per decade {ratio}: {w:?}"
+        );
+    }
+}
+
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
+#[test]
+fn self_distance_matches_brute_force_on_random_curves() {
+    let mut rng = Lcg(3);
+    for trial in 0..20 {
+        let n = 50 + 40 * trial;
+        // a random walk with persistence: curls back near itself often
+        let mut dir = Vector3::new(1.0, 0.0, 0.0);
+        let mut p = Vector3::zeros();
+        let mut points = vec![p];
+        for _ in 0..n {
+            dir = (dir + 0.8 * Vector3::new(rng.next(), rng.next(), rng.next())).normalize();
+            p += dir / n as f64;
+            points.push(p);
+        }
+        let arc: Vec<f64> = (0..=n).map(|k| k as f64 / n as f64).collect();
+        for gap in [0.02, 0.05, 0.2] {
+            let fast = min_self_distance(&points, &arc, gap).unwrap();
+            let brute = min_self_distance_brute(&points, &arc, gap).unwrap();
+            assert!(
+                (fast.distance - brute.distance).abs() < 1e-12,
+                "n {n} gap {gap}: {fast:?} vs {brute:?}"
+            );
+            assert!(fast.s[1] - fast.s[0] >= gap - 1e-12);
+        }
+    }
+}

@@ -1,0 +1,213 @@
+//! Knot types and writhe of closed curves.
+
+use knotrod::geometry::knot::{knot_type, knot_type_along};
+use knotrod::geometry::writhe::writhe_closed;
+use nalgebra::{Rotation3, Vector3};
+use std::f64::consts::PI;
+
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+    fn direction(&mut self) -> Vector3<f64> {
+        loop {
+            let v = Vector3::new(self.next(), self.next(), self.next());
+            if v.norm() > 0.1 && v.norm() < 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+}
+
+fn curve(m: usize, f: impl Fn(f64) -> Vector3<f64>) -> Vec<Vector3<f64>> {
+    (0..m).map(|k| f(2.0 * PI * k as f64 / m as f64)).collect()
+}
+
+fn torus(p: f64, q: f64, m: usize) -> Vec<Vector3<f64>> {
+    curve(m, |t| {
+        Vector3::new(
+            (2.0 + (q * t).cos()) * (p * t).cos(),
+            (2.0 + (q * t).cos()) * (p * t).sin(),
+            (q * t).sin(),
+        )
+    })
+}
+
+fn figure_eight(m: usize) -> Vec<Vector3<f64>> {
+    curve(m, |t| {
+        Vector3::new(
+            (2.0 + (2.0 * t).cos()) * (3.0 * t).cos(),
+            (2.0 + (2.0 * t).cos()) * (3.0 * t).sin(),
+            (4.0 * t).sin(),
+        )
+    })
+}
+
+/// An unknot with many crossings in projection: a circle wound in a
+/// deep spiral that comes back out the same way (a "coiled" unknot).
+fn messy_unknot(m: usize) -> Vec<Vector3<f64>> {
+    curve(m, |t| {
+        // out along a 5-turn spiral at z = +1 side, back along it at z = -1 side
+        let u = t / (2.0 * PI);
+        let (r, z, ang) = if u < 0.5 {
+            let w = u / 0.5;
+            (1.0 + 2.0 * w, 0.3 * (PI * w).sin() + 0.05, 10.0 * PI * w)
+        } else {
+            let w = (1.0 - u) / 0.5;
+            (
+                1.0 + 2.0 * w + 0.3,
+                -0.3 * (PI * w).sin() - 0.05,
+                10.0 * PI * w + 0.2,
+            )
+        };
+        Vector3::new(r * ang.cos(), r * ang.sin(), z + 0.4 * (3.0 * ang).sin())
+    })
+}
+
+fn determinant_in_random_directions(points: &[Vector3<f64>], seed: u64) -> Vec<u64> {
+    let mut rng = Lcg(seed);
+    (0..20)
+        .filter_map(|_| knot_type_along(points, &rng.direction()).ok())
+        .map(|(poly, _)| {
+            poly.iter()
+                .enumerate()
+                .map(|(j, c)| if j % 2 == 0 { *c } else { -c })
+                .sum::<i64>()
+                .unsigned_abs()
+        })
+        .collect()
+}
+
+#[test]
+fn torus_and_figure_eight_knots() {
+    let cases: Vec<(&str, Vec<Vector3<f64>>, u64, Vec<i64>)> = vec![
+        ("T(2,3)", torus(2.0, 3.0, 300), 3, vec![1, -1, 1]),
+        ("T(3,2) mirror", torus(2.0, -3.0, 300), 3, vec![1, -1, 1]),
+        ("T(2,5)", torus(2.0, 5.0, 500), 5, vec![1, -1, 1, -1, 1]),
+        ("figure-eight", figure_eight(400), 5, vec![-1, 3, -1]),
+        (
+            "circle",
+            curve(100, |t| Vector3::new(t.cos(), t.sin(), 0.0)),
+            1,
+            vec![1],
+        ),
+    ];
+    for (name, pts, det, poly) in cases {
+        let k = knot_type(&pts);
+        assert_eq!(k.determinant, det, "{name}: {k:?}");
+        assert_eq!(k.alexander, poly, "{name}: {k:?}");
+        assert!(!k.ambiguous, "{name}");
+        let dets = determinant_in_random_directions(&pts, 11);
+        assert!(dets.len() >= 18, "{name}: too many degenerate projections");
+        assert!(dets.iter().all(|d| *d == det), "{name}: {dets:?}");
+    }
+}
+
+#[test]
+fn messy_unknot_is_unknot_from_every_direction() {
+    let pts = messy_unknot(2000);
+    let mut rng = Lcg(5);
+    let mut max_crossings = 0;
+    for _ in 0..20 {
+        if let Ok((poly, n)) = knot_type_along(&pts, &rng.direction()) {
+            assert_eq!(poly, vec![1]);
+            max_crossings = max_crossings.max(n);
+        }
+    }
+    assert!(
+        max_crossings >= 10,
+        "the test curve should be messy: {max_crossings} crossings"
+    );
+    assert_eq!(knot_type(&pts).determinant, 1);
+}
+
+#[test]
+fn writhe_of_planar_and_symmetric_curves_vanishes() {
+    let circle = curve(200, |t| Vector3::new(t.cos(), t.sin(), 0.0));
+    assert!(writhe_closed(&circle).abs() < 1e-14);
+    let planar = curve(300, |t| {
+        Vector3::new(
+            (2.0 + (3.0 * t).cos()) * t.cos(),
+            (2.0 + (3.0 * t).cos()) * t.sin(),
+            0.0,
+        )
+    });
+    assert!(writhe_closed(&planar).abs() < 1e-14);
+}
+
+#[test]
+fn writhe_is_invariant_and_converges_with_resolution() {
+    let w: Vec<f64> = [200, 400, 800]
+        .iter()
+        .map(|&m| writhe_closed(&torus(2.0, 3.0, m)))
+        .collect();
+    // second-order convergence of the polygon's writhe to the smooth curve's
+    let order = ((w[0] - w[1]) / (w[1] - w[2])).log2();
+    assert!((order - 2.0).abs() < 0.2, "order {order}, writhes {w:?}");
+    // rigid motions and a shift of the starting vertex change nothing
+    let base = torus(2.0, 3.0, 400);
+    let rot = Rotation3::from_euler_angles(0.3, -1.1, 2.0);
+    let moved: Vec<Vector3<f64>> = base
+        .iter()
+        .map(|p| rot * p + Vector3::new(1.0, 2.0, 3.0))
+        .collect();
+    assert!((writhe_closed(&moved) - w[1]).abs() < 1e-11);
+    let mut shifted = base.clone();
+    shifted.rotate_left(37);
+    assert!((writhe_closed(&shifted) - w[1]).abs() < 1e-11);
+    // a mirror image has the opposite writhe
+    let mirror: Vec<Vector3<f64>> = base.iter().map(|p| Vector3::new(p.x, p.y, -p.z)).collect();
+    assert!((writhe_closed(&mirror) + w[1]).abs() < 1e-11);
+}
+
+#[test]
+fn passing_a_strand_through_another_changes_writhe_by_two() {
+    // a trefoil deformed by pushing one crossing through: family with a
+    // parameter moving one strand in depth across another
+    let family = |lift: f64| -> Vec<Vector3<f64>> {
+        curve(600, |t| {
+            let p = Vector3::new(
+                (2.0 + (3.0 * t).cos()) * (2.0 * t).cos(),
+                (2.0 + (3.0 * t).cos()) * (2.0 * t).sin(),
+                (3.0 * t).sin(),
+            );
+            // near t = π/6 the strand is at a crossing; push it in z
+            let bump = (-((t - PI / 6.0) / 0.15).powi(2)).exp();
+            p + Vector3::new(0.0, 0.0, lift * bump)
+        })
+    };
+    let before = writhe_closed(&family(0.0));
+    let after = writhe_closed(&family(-3.0));
+    let jump = after - before;
+    // the smooth deformation away from the crossing changes writhe continuously,
+    // the passage adds exactly ±2: check the change through the passage with a
+    // pair of nearby curves on both sides
+    let (lo, hi) = bracket_passage(&family);
+    let d = writhe_closed(&family(hi)) - writhe_closed(&family(lo));
+    assert!(
+        (d.abs() - 2.0).abs() < 1e-3,
+        "jump {d} at passage, total change {jump}"
+    );
+    assert_ne!(
+        knot_type(&family(0.0)).determinant,
+        knot_type(&family(-3.0)).determinant
+    );
+}
+
+/// Find lift values just before and after the strand passage (where the knot
+/// type changes), within 1e-7.
+fn bracket_passage(family: &dyn Fn(f64) -> Vec<Vector3<f64>>) -> (f64, f64) {
+    let det = |l: f64| knot_type(&family(l)).determinant;
+    let (mut lo, mut hi) = (0.0, -3.0);
+    let d0 = det(lo);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if det(mid) == d0 { lo = mid } else { hi = mid }
+    }
+    (lo, hi)
+}
