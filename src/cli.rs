@@ -1,11 +1,16 @@
 //! The `knotrod` command line.
 
 use crate::equilibrium::solve_scene;
+use crate::geometry::closure::{extent, ray_closure};
+use crate::geometry::knot::knot_type;
+use crate::geometry::polyline::read_points;
+use crate::geometry::writhe::writhe_closed;
 use crate::scene::Scene;
 use crate::summary::{Summary, print_equilibrium};
 use crate::validation;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
+use nalgebra::Vector3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -32,6 +37,21 @@ pub enum Command {
         #[arg(long)]
         segments: Option<usize>,
     },
+    /// Writhe and knot type of any curve (one "x y z" or "x,y,z" point per line).
+    Knot {
+        /// The curve file.
+        curve: PathBuf,
+        /// The curve is a closed loop (last point joins the first).
+        #[arg(long)]
+        closed: bool,
+        /// How an open curve is closed: by rays along its end tangents, or
+        /// along ∓z from the first and last points (the paper's closure).
+        #[arg(long, value_enum, default_value = "tangent")]
+        rays: RayKind,
+        /// Write a JSON answer here ("-" for stdout).
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Regenerate the validation report (docs/validation.md) on stdout.
     Validate {
         /// Folder holding the scenes.
@@ -48,6 +68,15 @@ pub enum Command {
     },
 }
 
+/// Directions of the closing rays of an open curve.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum RayKind {
+    /// Along the end tangents.
+    Tangent,
+    /// Along −z from the first point and +z from the last.
+    Z,
+}
+
 /// Run the command line.
 pub fn main_with(cli: Cli) -> Result<()> {
     match cli.command {
@@ -57,6 +86,12 @@ pub fn main_with(cli: Cli) -> Result<()> {
             segments,
         } => run(&scene, json, segments),
         Command::Convergence { scene, segments } => convergence(&scene, &segments),
+        Command::Knot {
+            curve,
+            closed,
+            rays,
+            json,
+        } => knot(&curve, closed, rays, json),
         Command::Validate { scenes } => {
             write!(std::io::stdout().lock(), "{}", validation::report(&scenes)?)?;
             Ok(())
@@ -105,4 +140,107 @@ fn convergence(path: &Path, segments: &[usize]) -> Result<()> {
         validation::convergence_table(&scene, segments)?
     )?;
     Ok(())
+}
+
+fn knot(path: &Path, closed: bool, rays: RayKind, json: Option<PathBuf>) -> Result<()> {
+    let points = read_points(path)?;
+    let (writhe, kt) = if closed {
+        (writhe_closed(&points), knot_type(&points))
+    } else {
+        let m = points.len();
+        let (bottom, top) = match rays {
+            RayKind::Tangent => (points[0] - points[1], points[m - 1] - points[m - 2]),
+            RayKind::Z => (-Vector3::z(), Vector3::z()),
+        };
+        let size = extent(&points).max(1e-300);
+        // writhe error of the closure decays as 1/(ray length)
+        let w = writhe_closed(&ray_closure(&points, bottom, top, 1e6 * size));
+        (
+            w,
+            knot_type(&ray_closure(
+                &points,
+                bottom,
+                top,
+                2.0 * size + size.max(1.0),
+            )),
+        )
+    };
+    let answer = serde_json::json!({
+        "curve": path.display().to_string(),
+        "points": points.len(),
+        "closed": closed,
+        "writhe": writhe,
+        "knot_determinant": kt.determinant,
+        "alexander": kt.alexander,
+        "knot_name": kt.name,
+        "crossings": kt.crossings,
+        "projections": kt.directions,
+        "ambiguous": kt.ambiguous,
+    });
+    let mut out = std::io::stdout().lock();
+    match json {
+        Some(p) if p.as_os_str() == "-" => {
+            writeln!(out, "{}", serde_json::to_string_pretty(&answer)?)?
+        }
+        other => {
+            writeln!(
+                out,
+                "curve {} ({} points, {})",
+                path.display(),
+                points.len(),
+                if closed { "closed" } else { "closed by rays" }
+            )?;
+            writeln!(out, "  writhe {writhe:.6}")?;
+            writeln!(out, "  knot determinant {}", kt.determinant)?;
+            writeln!(out, "  Alexander polynomial {}", polynomial(&kt.alexander))?;
+            writeln!(
+                out,
+                "  likely knot {}",
+                kt.name
+                    .as_deref()
+                    .unwrap_or("not in the table (more than 7 crossings?)")
+            )?;
+            if kt.ambiguous {
+                writeln!(
+                    out,
+                    "  AMBIGUOUS: projections disagree or are degenerate (the curve may pass through itself)"
+                )?;
+            }
+            if let Some(p) = other {
+                std::fs::write(&p, serde_json::to_string_pretty(&answer)? + "\n")
+                    .with_context(|| format!("writing {}", p.display()))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Δ(t) as text, e.g. "1 - t + t^2".
+fn polynomial(c: &[i64]) -> String {
+    if c.is_empty() {
+        return "unknown".into();
+    }
+    let mut s = String::new();
+    for (j, &a) in c.iter().enumerate().filter(|(_, a)| **a != 0) {
+        let mag = a.unsigned_abs();
+        let sign = if a < 0 { "-" } else { "+" };
+        if s.is_empty() {
+            if a < 0 {
+                s.push('-');
+            }
+        } else {
+            s += &format!(" {sign} ");
+        }
+        let coef = if mag == 1 && j > 0 {
+            String::new()
+        } else {
+            mag.to_string()
+        };
+        s += &match j {
+            0 => mag.to_string(),
+            1 => format!("{coef}t"),
+            _ => format!("{coef}t^{j}"),
+        };
+    }
+    s
 }

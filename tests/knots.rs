@@ -85,7 +85,8 @@ fn determinant_in_random_directions(points: &[Vector3<f64>], seed: u64) -> Vec<u
 
 #[test]
 fn torus_and_figure_eight_knots() {
-    let cases: Vec<(&str, Vec<Vector3<f64>>, u64, Vec<i64>)> = vec![
+    type Case = (&'static str, Vec<Vector3<f64>>, u64, Vec<i64>);
+    let cases: Vec<Case> = vec![
         ("T(2,3)", torus(2.0, 3.0, 300), 3, vec![1, -1, 1]),
         ("T(3,2) mirror", torus(2.0, -3.0, 300), 3, vec![1, -1, 1]),
         ("T(2,5)", torus(2.0, 5.0, 500), 5, vec![1, -1, 1, -1, 1]),

@@ -197,3 +197,80 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("Newton") && !err.contains("panicked"), "{err}");
 }
+
+fn write_curve(path: &std::path::Path, sep: &str, f: impl Fn(f64) -> [f64; 3], m: usize) {
+    let mut text = String::from("# test curve\n");
+    for k in 0..m {
+        let p = f(2.0 * std::f64::consts::PI * k as f64 / m as f64);
+        text += &format!("{}{sep}{}{sep}{}\n", p[0], p[1], p[2]);
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn knot_command_names_small_knots() {
+    let dir = std::env::temp_dir().join(format!("knotrod-knot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let torus = |p: f64, q: f64| {
+        move |t: f64| {
+            [
+                (2.0 + (q * t).cos()) * (p * t).cos(),
+                (2.0 + (q * t).cos()) * (p * t).sin(),
+                (q * t).sin(),
+            ]
+        }
+    };
+    let eight = |t: f64| {
+        [
+            (2.0 + (2.0 * t).cos()) * (3.0 * t).cos(),
+            (2.0 + (2.0 * t).cos()) * (3.0 * t).sin(),
+            (4.0 * t).sin(),
+        ]
+    };
+    let cases: [(&str, Box<dyn Fn(f64) -> [f64; 3]>, u64, &str); 3] = [
+        ("t23.csv", Box::new(torus(2.0, 3.0)), 3, "3_1"),
+        ("t25.txt", Box::new(torus(2.0, 5.0)), 5, "5_1"),
+        ("eight.xyz", Box::new(eight), 5, "4_1"),
+    ];
+    for (name, f, det, knot) in cases {
+        let path = dir.join(name);
+        write_curve(
+            &path,
+            if name.ends_with(".csv") { "," } else { " " },
+            f,
+            400,
+        );
+        let out = knotrod(&["knot", path.to_str().unwrap(), "--closed", "--json", "-"]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["knot_determinant"].as_u64(), Some(det), "{name}: {v}");
+        assert!(
+            v["knot_name"].as_str().unwrap().starts_with(knot),
+            "{name}: {v}"
+        );
+        assert_eq!(v["ambiguous"].as_bool(), Some(false));
+    }
+    // an open arc of the trefoil closed by rays along ±z is still a trefoil
+    let arc = dir.join("open.txt");
+    let mut text = String::new();
+    for k in 0..=300 {
+        let t = 0.2 + (2.0 * std::f64::consts::PI - 0.4) * k as f64 / 300.0;
+        let p = torus(2.0, 3.0)(t);
+        text += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    std::fs::write(&arc, text).unwrap();
+    let out = knotrod(&["knot", arc.to_str().unwrap(), "--json", "-"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["knot_determinant"].as_u64(), Some(3), "{v}");
+    // malformed input: a clear error naming the line
+    let bad = dir.join("bad.txt");
+    std::fs::write(&bad, "0 0 0\n1 1\n2 2 2\n").unwrap();
+    let out = knotrod(&["knot", bad.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("line 2") && !err.contains("panicked"), "{err}");
+}

@@ -5,7 +5,8 @@ use nalgebra::Vector3;
 
 /// Ray closure of an open polyline whose first point is the s = 0 end and last
 /// point the s = 1 end: rays of length `ray` along `bottom_dir` from the first
-/// point and `top_dir` from the last, then a rectangle `ray` away to the side.
+/// point and `top_dir` from the last, joined by a path at least about `ray`
+/// minus the curve's extent away from the curve.
 pub fn ray_closure(
     points: &[Vector3<f64>],
     bottom_dir: Vector3<f64>,

@@ -4,5 +4,6 @@
 pub mod closure;
 pub mod distance;
 pub mod knot;
+pub mod polyline;
 pub mod walls;
 pub mod writhe;
