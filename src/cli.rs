@@ -1,12 +1,12 @@
 //! The `knotrod` command line.
 
-use crate::equilibrium::solve_scene;
 use crate::geometry::closure::{extent, ray_closure};
 use crate::geometry::knot::knot_type;
 use crate::geometry::polyline::read_points;
 use crate::geometry::writhe::writhe_closed;
+use crate::run::run_scene;
 use crate::scene::Scene;
-use crate::summary::{Summary, print_equilibrium};
+use crate::summary::{Summary, print_equilibrium, print_events};
 use crate::validation;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
@@ -109,27 +109,91 @@ fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()
     }
     let model = scene.rod_model(segments);
     let start = std::time::Instant::now();
-    let eq = solve_scene(&scene, segments)?;
+    let json = json.or(scene.output.json.clone());
     let mut summary = Summary::new(&scene, &model);
+    // results are streamed as they come (one JSON line per equilibrium)
+    let mut stream = match &json {
+        Some(p) => {
+            if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir)?;
+            }
+            let lines = p.with_extension("jsonl");
+            Some((
+                std::io::BufWriter::new(
+                    std::fs::File::create(&lines)
+                        .with_context(|| format!("creating {}", lines.display()))?,
+                ),
+                lines,
+            ))
+        }
+        None => None,
+    };
+    let progress = indicatif::ProgressBar::new_spinner();
+    progress.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {elapsed} {pos} equilibria — {msg}")
+            .unwrap(),
+    );
+    let mut equilibria = Vec::new();
+    let result = {
+        let mut observer = |eq: crate::equilibrium::Equilibrium| -> Result<()> {
+            if let Some((w, _)) = stream.as_mut() {
+                serde_json::to_writer(&mut *w, &eq)?;
+                w.write_all(b"\n")?;
+                w.flush()?;
+            }
+            progress.inc(1);
+            progress.set_message(format!(
+                "branch {}: z* = {:.4}, δ = {:.4}, φ/2π = {:.4}, Tw = {:.4}{}",
+                eq.branch,
+                eq.z_star,
+                eq.delta,
+                eq.phi_over_2pi,
+                eq.twist,
+                if eq.stable { "" } else { " (unstable)" }
+            ));
+            equilibria.push(eq);
+            Ok(())
+        };
+        run_scene(&scene, segments, &mut observer)
+    };
+    progress.finish_and_clear();
+    summary.equilibria = equilibria;
     let mut out = std::io::stdout().lock();
     writeln!(
         out,
-        "scene {} — Kirchhoff rod, K2 = {}, K3 = {}, N = {} ({:.2} s)",
+        "scene {} — Kirchhoff rod, K2 = {}, K3 = {}, N = {} ({:.2} s, {} equilibria)",
         summary.scene,
         model.k2,
         model.k3,
         model.segments,
-        start.elapsed().as_secs_f64()
+        start.elapsed().as_secs_f64(),
+        summary.equilibria.len()
     )?;
-    print_equilibrium(&eq, &scene, &mut out)?;
-    summary.equilibria.push(eq);
-    if let Some(path) = json.or(scene.output.json.clone()) {
+    let failed = match result {
+        Ok(events) => {
+            summary.events = events;
+            None
+        }
+        Err(e) => Some(e),
+    };
+    if scene.continuation.is_none() {
+        if let Some(eq) = summary.equilibria.first() {
+            print_equilibrium(eq, &scene, &mut out)?;
+        }
+    } else {
+        print_events(&summary.events, &mut out)?;
+    }
+    // the summary is written whatever happened, with what was computed
+    if let Some(path) = &json {
         summary
-            .write(&path)
+            .write(path)
             .with_context(|| format!("writing {}", path.display()))?;
         writeln!(out, "summary written to {}", path.display())?;
     }
-    Ok(())
+    match failed {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
 }
 
 fn convergence(path: &Path, segments: &[usize]) -> Result<()> {

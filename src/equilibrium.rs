@@ -77,6 +77,9 @@ pub struct Equilibrium {
     pub ray_distance: [f64; 2],
     /// Walled, trefoil, stable and no closer to itself than the rod diameter.
     pub good_knot: bool,
+    /// Branch this equilibrium lies on (0 for a single solve).
+    #[serde(default)]
+    pub branch: usize,
     /// The full discrete state (restart with `[initial] shape = "file"`).
     pub state: RodState,
 }
@@ -264,6 +267,7 @@ pub fn analyse(
         min_self_distance_s: shape.self_approach.map_or([f64::NAN; 2], |a| a.s),
         wall_distance: shape.wall_distance,
         ray_distance: shape.ray_distance,
+        branch: 0,
         state: state.clone(),
     })
 }

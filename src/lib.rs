@@ -2,10 +2,12 @@
 //! (discrete elastic rods), after "Stable elastic knots with no self-contact".
 
 pub mod analytic;
+pub mod branch;
 pub mod cli;
 pub mod equilibrium;
 pub mod geometry;
 pub mod model;
+pub mod run;
 pub mod scene;
 pub mod solve;
 pub mod stability;

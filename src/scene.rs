@@ -1,7 +1,7 @@
 //! Scene files (TOML): model, clamps, initial shape, solver settings, outputs.
 //! Every field is checked; errors name the field.
 
-use crate::model::rod::{Clamps, RodModel};
+use crate::model::rod::{Clamps, Parameter, RodModel};
 use crate::solve::newton::NewtonSettings;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -29,6 +29,13 @@ pub struct Scene {
     /// Stability settings.
     #[serde(default)]
     pub stability: StabilitySpec,
+    /// Continuation of the equilibrium in one parameter (a branch).
+    #[serde(default)]
+    pub continuation: Option<ContinuationSpec>,
+    /// Repeat the continuation at several values of another parameter, each
+    /// reached by continuation from the previous one.
+    #[serde(default)]
+    pub sweep: Option<SweepSpec>,
     /// Knot diagnostics settings.
     #[serde(default)]
     pub diagnostics: DiagnosticsSpec,
@@ -143,6 +150,61 @@ impl Default for StabilitySpec {
     fn default() -> Self {
         StabilitySpec { eigenvalues: 4 }
     }
+}
+
+/// `[continuation]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContinuationSpec {
+    /// "phi" (as φ/2π), "z_star" or "delta".
+    pub parameter: Parameter,
+    /// Stop when the parameter leaves [lo, hi].
+    pub range: [f64; 2],
+    /// "up", "down" or "both" from the start.
+    #[serde(default)]
+    pub direction: Direction,
+    /// Locate folds, stability changes, branch points, walls, crossings.
+    #[serde(default = "yes")]
+    pub locate_events: bool,
+    /// Follow the branches bifurcating at branch points.
+    #[serde(default)]
+    pub switch_branches: bool,
+    /// Initial arclength step.
+    #[serde(default)]
+    pub step: Option<f64>,
+    /// Largest arclength step.
+    #[serde(default)]
+    pub max_step: Option<f64>,
+    /// Most points per direction.
+    #[serde(default)]
+    pub max_points: Option<i64>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// Direction of a continuation from its start.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Direction {
+    /// Increasing parameter.
+    Up,
+    /// Decreasing parameter.
+    Down,
+    /// Both, one after the other.
+    #[default]
+    Both,
+}
+
+/// `[sweep]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSpec {
+    /// The swept parameter.
+    pub parameter: Parameter,
+    /// Its values, in order (each reached by continuation from the previous).
+    pub values: Vec<f64>,
 }
 
 /// `[diagnostics]`
@@ -366,6 +428,53 @@ impl Scene {
         positive("solver.max_step", s.max_step)?;
         if s.max_iterations == 0 {
             return Err(invalid("solver.max_iterations", "must be >= 1"));
+        }
+        if let Some(c) = &self.continuation {
+            finite("continuation.range", c.range[0])?;
+            finite("continuation.range", c.range[1])?;
+            if c.range[0] >= c.range[1] {
+                return Err(invalid(
+                    "continuation.range",
+                    "must be [lo, hi] with lo < hi",
+                ));
+            }
+            let start = c.parameter.value(&self.clamps());
+            if start < c.range[0] || start > c.range[1] {
+                return Err(invalid(
+                    "continuation.range",
+                    format!("does not contain the start value {start}"),
+                ));
+            }
+            for (field, v) in [
+                ("continuation.step", c.step),
+                ("continuation.max_step", c.max_step),
+            ] {
+                if let Some(v) = v {
+                    positive(field, v)?;
+                }
+            }
+            if let Some(m) = c.max_points {
+                if m < 1 {
+                    return Err(invalid("continuation.max_points", "must be >= 1"));
+                }
+            }
+        }
+        if let Some(sw) = &self.sweep {
+            if self.continuation.is_none() {
+                return Err(invalid("sweep", "needs a [continuation] to repeat"));
+            }
+            if sw.values.is_empty() {
+                return Err(invalid("sweep.values", "must not be empty"));
+            }
+            for v in &sw.values {
+                finite("sweep.values", *v)?;
+            }
+            if Some(sw.parameter) == self.continuation.as_ref().map(|c| c.parameter) {
+                return Err(invalid(
+                    "sweep.parameter",
+                    "must differ from continuation.parameter",
+                ));
+            }
         }
         let d = &self.diagnostics;
         positive("diagnostics.self_distance_gap", d.self_distance_gap)?;

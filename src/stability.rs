@@ -25,6 +25,9 @@ pub struct Spectrum {
     pub values: Vec<f64>,
     /// Number of negative eigenvalues (from the inertia of a factorisation).
     pub negative_count: usize,
+    /// Eigenvectors (on the free dofs) of `values`, in the same order.
+    #[serde(skip)]
+    pub vectors: Vec<Vec<f64>>,
 }
 
 /// Stability analysis failed.
@@ -201,8 +204,8 @@ pub fn lowest_eigenvalues(
     let k = k.min(dim);
     if k == 0 {
         return Ok(Spectrum {
-            values: vec![],
             negative_count,
+            ..Default::default()
         });
     }
     let op = ShiftInvert {
@@ -211,7 +214,7 @@ pub fn lowest_eigenvalues(
         weight: &weight,
         full_dim: n,
     };
-    let mu: Vec<f64> = if dim <= 128 {
+    let mu: Vec<(f64, Vec<f64>)> = if dim <= 128 {
         // small problems: the operator as a dense matrix (faer's Lanczos needs
         // a subspace smaller than the space)
         let mut a = Mat::<f64>::zeros(dim, dim);
@@ -225,8 +228,10 @@ pub fn lowest_eigenvalues(
         let evd = a
             .self_adjoint_eigen(faer::Side::Lower)
             .map_err(|_| StabilityError::NonFinite)?;
-        let mut all: Vec<f64> = (0..dim).map(|i| evd.S()[i]).collect();
-        all.sort_by(|x, y| y.total_cmp(x));
+        let mut all: Vec<(f64, Vec<f64>)> = (0..dim)
+            .map(|i| (evd.S()[i], (0..dim).map(|r| evd.U()[(r, i)]).collect()))
+            .collect();
+        all.sort_by(|x, y| y.0.total_cmp(&x.0));
         all.truncate(k);
         all
     } else {
@@ -254,16 +259,29 @@ pub fn lowest_eigenvalues(
             MemStack::new(&mut buf),
             params,
         );
-        mu
+        mu.iter()
+            .enumerate()
+            .map(|(c, m)| (*m, (0..dim).map(|r| vecs[(r, c)]).collect()))
+            .collect()
     };
-    let mut lambda: Vec<f64> = mu
-        .iter()
-        .filter(|m| **m != 0.0)
-        .map(|m| sigma + 1.0 / m)
+    // back to eigenvalues of the problem and eigenvectors on the full dofs
+    // (for the pencil, v = W y scaled back: v = (H - σM)⁻¹ W y up to a factor;
+    // the massive components M^{-1/2} y suffice to show the mode's shape)
+    let mut modes: Vec<(f64, Vec<f64>)> = mu
+        .into_iter()
+        .filter(|(m, _)| *m != 0.0)
+        .map(|(m, y)| {
+            let mut v = vec![0.0; n];
+            for (k, &d) in reduced.iter().enumerate() {
+                v[d] = y[k] / weight[k];
+            }
+            (sigma + 1.0 / m, v)
+        })
         .collect();
-    lambda.sort_by(|a, b| a.total_cmp(b));
+    modes.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(Spectrum {
-        values: lambda,
+        values: modes.iter().map(|m| m.0).collect(),
+        vectors: modes.into_iter().map(|m| m.1).collect(),
         negative_count,
     })
 }

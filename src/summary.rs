@@ -1,5 +1,6 @@
 //! The machine-readable run summary (JSON) and its human-readable print.
 
+use crate::branch::Event;
 use crate::equilibrium::Equilibrium;
 use crate::model::rod::RodModel;
 use crate::scene::Scene;
@@ -34,7 +35,7 @@ pub struct Summary {
     /// Equilibria in the order computed.
     pub equilibria: Vec<Equilibrium>,
     /// Located events (filled by continuation runs).
-    pub events: Vec<serde_json::Value>,
+    pub events: Vec<Event>,
 }
 
 impl Summary {
@@ -210,6 +211,27 @@ pub fn print_equilibrium(
                 if s == e.stable { "agrees" } else { "DISAGREES" }
             )?;
         }
+    }
+    Ok(())
+}
+
+/// Events as a table.
+pub fn print_events(events: &[Event], out: &mut impl Write) -> std::io::Result<()> {
+    if events.is_empty() {
+        return Ok(());
+    }
+    writeln!(out, "events:")?;
+    writeln!(
+        out,
+        "  {:<6} {:<13} {:>6} {:>9} {:>9} {:>8}  detail",
+        "label", "kind", "branch", "z*", "φ/2π", "Tw"
+    )?;
+    for e in events {
+        writeln!(
+            out,
+            "  {:<6} {:<13} {:>6} {:>9.5} {:>9.5} {:>8.4}  {}",
+            e.label, e.kind, e.branch, e.z_star, e.phi_over_2pi, e.twist, e.detail
+        )?;
     }
     Ok(())
 }

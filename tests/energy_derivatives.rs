@@ -150,3 +150,68 @@ fn hessian_is_symmetric_and_full_gradient_agrees() {
         }
     }
 }
+
+/// `state` with its clamp parameter set to `value` and free dofs moved by `dq`,
+/// all frames transported in one step from `state` (the chart of the
+/// derivatives).
+fn moved(
+    state: &RodState,
+    p: knotrod::model::rod::Parameter,
+    value: f64,
+    dq: &[f64],
+    map: &knotrod::model::rod::DofMap,
+) -> RodState {
+    let n = state.segments();
+    let clamps = p.with(&state.clamps, value);
+    let mut next = state.clone();
+    let shift = clamps.end_point() - state.clamps.end_point();
+    next.nodes[n] += shift;
+    next.nodes[n + 1] += shift;
+    next.theta[n] = clamps.phi;
+    next.clamps = clamps;
+    for i in 2..n {
+        let d = map.node(i).unwrap();
+        next.nodes[i] += Vector3::new(dq[d], dq[d + 1], dq[d + 2]);
+    }
+    for j in 1..n {
+        next.theta[j] += dq[map.theta(j).unwrap()];
+    }
+    next.update_frames_from(state);
+    next
+}
+
+#[test]
+fn parameter_derivative_of_the_gradient_matches_finite_differences() {
+    use knotrod::model::rod::Parameter;
+    let (model, state) = random_state(12, 5);
+    let energy = RodEnergy::new(model);
+    let map = energy.map;
+    let n = map.len();
+    for p in [Parameter::ZStar, Parameter::Delta, Parameter::Phi] {
+        let mut exact = vec![0.0; n];
+        energy.gradient_parameter_derivative(&state, &p.velocity(&state.clamps), &mut exact);
+        let v0 = p.value(&state.clamps);
+        let (eq, ep) = (2e-5, 2e-5);
+        let mut fd = vec![0.0; n];
+        for d in 0..n {
+            let mut v = 0.0;
+            for (sq, sp, w) in [
+                (1.0, 1.0, 1.0),
+                (1.0, -1.0, -1.0),
+                (-1.0, 1.0, -1.0),
+                (-1.0, -1.0, 1.0),
+            ] {
+                let mut dq = vec![0.0; n];
+                dq[d] = sq * eq;
+                v += w * energy.energy(&moved(&state, p, v0 + sp * ep, &dq, &map));
+            }
+            fd[d] = v / (4.0 * eq * ep);
+        }
+        let e = rel(&fd, &exact);
+        assert!(e < 1e-6, "{p:?}: relative error {e:e}");
+        assert!(
+            exact.iter().any(|v| v.abs() > 1e-3),
+            "{p:?}: derivative vanishes"
+        );
+    }
+}

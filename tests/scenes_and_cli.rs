@@ -227,7 +227,12 @@ fn knot_command_names_small_knots() {
             (4.0 * t).sin(),
         ]
     };
-    type Case = (&'static str, Box<dyn Fn(f64) -> [f64; 3]>, u64, &'static str);
+    type Case = (
+        &'static str,
+        Box<dyn Fn(f64) -> [f64; 3]>,
+        u64,
+        &'static str,
+    );
     let cases: [Case; 3] = [
         ("t23.csv", Box::new(torus(2.0, 3.0)), 3, "3_1"),
         ("t25.txt", Box::new(torus(2.0, 5.0)), 5, "5_1"),

@@ -427,3 +427,70 @@ impl RodEnergy {
             .collect()
     }
 }
+
+/// Velocity of the s = 1 clamp's dofs with respect to a loading parameter:
+/// both clamp nodes translate by `end`, the clamp angle turns by `theta`.
+#[derive(Clone, Copy, Debug)]
+pub struct ClampVelocity {
+    /// d(end point)/dp.
+    pub end: Vector3<f64>,
+    /// dφ/dp.
+    pub theta: f64,
+}
+
+impl RodEnergy {
+    /// ∂(∇E)/∂p on the free dofs when the s = 1 clamp moves with `velocity`:
+    /// the mixed second derivatives (free × clamp dofs) of the three stencils
+    /// that touch the clamp, applied to the clamp's velocity.
+    pub fn gradient_parameter_derivative(
+        &self,
+        state: &RodState,
+        velocity: &ClampVelocity,
+        out: &mut [f64],
+    ) {
+        let n = self.model.segments;
+        out.iter_mut().for_each(|v| *v = 0.0);
+        let e = velocity.end;
+        if self.terms.bending || self.terms.twisting {
+            for i in [n - 1, n] {
+                let c = VertexFrames::at(state, i);
+                let q = SVector::<f64, 11>::from(vertex_variables(state, i));
+                let (_, _, hl) = num_dual::hessian(
+                    |v: SVector<_, 11>| vertex_energy(v.as_slice(), &c, &self.model, self.terms),
+                    &q,
+                );
+                // local velocity: nodes i-1, i, i+1 and angles i-1, i
+                let mut vel = [0.0; 11];
+                for (k, node) in [i - 1, i, i + 1].into_iter().enumerate() {
+                    if node >= n {
+                        vel[3 * k..3 * k + 3].copy_from_slice(e.as_slice());
+                    }
+                }
+                if i == n {
+                    vel[10] = velocity.theta;
+                }
+                let dofs = self.map.vertex_stencil(i);
+                for (a, d) in dofs.iter().enumerate() {
+                    if let Some(d) = d {
+                        out[*d] += (0..11).map(|b| hl[(a, b)] * vel[b]).sum::<f64>();
+                    }
+                }
+            }
+        }
+        if self.terms.stretching {
+            let j = n - 1;
+            let q = SVector::<f64, 6>::from(edge_variables(state, j));
+            let (_, _, hl) = num_dual::hessian(
+                |v: SVector<_, 6>| stretching_energy(v.as_slice(), &self.model),
+                &q,
+            );
+            let vel = [0.0, 0.0, 0.0, e.x, e.y, e.z];
+            let dofs = self.map.edge_stencil(j);
+            for (a, d) in dofs.iter().enumerate() {
+                if let Some(d) = d {
+                    out[*d] += (0..6).map(|b| hl[(a, b)] * vel[b]).sum::<f64>();
+                }
+            }
+        }
+    }
+}

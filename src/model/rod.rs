@@ -385,3 +385,61 @@ impl RodState {
         (points, arc)
     }
 }
+
+/// A loading parameter of the s = 1 clamp.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Parameter {
+    /// End displacement z*.
+    ZStar,
+    /// End shift δ.
+    Delta,
+    /// End rotation, measured as φ/2π.
+    #[serde(alias = "phi_over_2pi")]
+    Phi,
+}
+
+impl Parameter {
+    /// Its value for `clamps` (φ as φ/2π).
+    pub fn value(&self, c: &Clamps) -> f64 {
+        match self {
+            Parameter::ZStar => c.z_star,
+            Parameter::Delta => c.delta,
+            Parameter::Phi => c.phi_over_2pi(),
+        }
+    }
+
+    /// `clamps` with this parameter set to `v`.
+    pub fn with(&self, c: &Clamps, v: f64) -> Clamps {
+        let mut c = *c;
+        match self {
+            Parameter::ZStar => c.z_star = v,
+            Parameter::Delta => c.delta = v,
+            Parameter::Phi => c.phi = 2.0 * PI * v,
+        }
+        c
+    }
+
+    /// How the clamp's dofs move with the parameter.
+    pub fn velocity(&self, c: &Clamps) -> crate::model::energy::ClampVelocity {
+        let half = c.phi / 2.0;
+        let (end, theta) = match self {
+            Parameter::ZStar => (Vector3::z(), 0.0),
+            Parameter::Delta => (Vector3::new(-half.cos(), -half.sin(), 0.0), 0.0),
+            Parameter::Phi => (
+                Vector3::new(c.delta * PI * half.sin(), -c.delta * PI * half.cos(), 0.0),
+                2.0 * PI,
+            ),
+        };
+        crate::model::energy::ClampVelocity { end, theta }
+    }
+
+    /// Name as in summaries.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Parameter::ZStar => "z_star",
+            Parameter::Delta => "delta",
+            Parameter::Phi => "phi_over_2pi",
+        }
+    }
+}

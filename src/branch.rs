@@ -1,0 +1,351 @@
+//! Branches of equilibria: continuation of a scene's equilibrium in one clamp
+//! parameter with its events located — folds, changes of stability, branch
+//! points (S), walls touched (W), self-crossings (X) and knot changes — and the
+//! bifurcating branches followed from branch points when asked.
+
+use crate::equilibrium::{Equilibrium, Measure, Shape, analyse};
+use crate::model::rod::{Parameter, RodState};
+use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
+use crate::solve::newton::{Newton, NewtonReport};
+use anyhow::Result;
+use serde::{Deserialize, Serialize};
+
+/// A located event.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Event {
+    /// "wall" | "crossing" | "stability" | "fold" | "branch_point" | "jump" | "knot_change" | "end".
+    pub kind: String,
+    /// Label as in the paper's figures (W1, W2, X, S, F1, ...).
+    pub label: String,
+    /// Where.
+    pub phi_over_2pi: f64,
+    /// Where.
+    pub z_star: f64,
+    /// Where.
+    pub delta: f64,
+    /// Twist there (the figures' vertical axis).
+    pub twist: f64,
+    /// Branch it lies on.
+    pub branch: usize,
+    /// Free text (e.g. negative eigenvalue counts on either side).
+    pub detail: String,
+}
+
+/// Test functions watched along a branch.
+#[derive(Clone, Debug)]
+struct Watch {
+    wall: f64,
+    knot: u64,
+    link: f64,
+}
+
+fn watch(state: &RodState, measure: &Measure) -> Watch {
+    let shape = Shape::of(state, measure);
+    Watch {
+        wall: shape.wall_distance,
+        knot: shape.knot.determinant,
+        link: state.twist() + shape.writhe,
+    }
+}
+
+/// What the caller gets for every accepted point.
+pub type Observer<'o> = dyn FnMut(Equilibrium) -> Result<()> + 'o;
+
+/// Options of a branch run.
+#[derive(Clone, Debug)]
+pub struct BranchOptions {
+    /// Continuation parameter.
+    pub parameter: Parameter,
+    /// Stop when the parameter leaves [lo, hi].
+    pub range: [f64; 2],
+    /// Numerical settings.
+    pub settings: ContinuationSettings,
+    /// Locate events (otherwise only accepted points).
+    pub locate_events: bool,
+    /// Follow the branches that bifurcate at branch points.
+    pub switch_branches: bool,
+    /// What to measure at each point.
+    pub measure: Measure,
+}
+
+/// Traces branches and collects events.
+pub struct BranchRun<'a, 'r> {
+    tracer: Tracer<'a>,
+    options: BranchOptions,
+    observer: &'r mut Observer<'r>,
+    /// Located events, in the order found.
+    pub events: Vec<Event>,
+    /// Branch points found (point, null vector), to switch onto.
+    branch_points: Vec<(Point, Vec<f64>, usize)>,
+    next_branch: usize,
+}
+
+fn event(kind: &str, p: &Point, branch: usize, detail: String) -> Event {
+    let c = p.state.clamps;
+    Event {
+        kind: kind.into(),
+        label: String::new(),
+        phi_over_2pi: c.phi_over_2pi(),
+        z_star: c.z_star,
+        delta: c.delta,
+        twist: p.state.twist(),
+        branch,
+        detail,
+    }
+}
+
+impl<'a, 'r> BranchRun<'a, 'r> {
+    /// A run on `newton`'s rod; branches are numbered from `first_branch`.
+    pub fn new(
+        newton: &'a mut Newton,
+        options: BranchOptions,
+        observer: &'r mut Observer<'r>,
+        first_branch: usize,
+    ) -> Self {
+        BranchRun {
+            tracer: Tracer::new(newton, options.parameter, options.settings.clone()),
+            options,
+            observer,
+            events: Vec::new(),
+            branch_points: Vec::new(),
+            next_branch: first_branch,
+        }
+    }
+
+    fn emit(&mut self, p: &Point, branch: usize) -> Result<()> {
+        let energy = self.tracer.newton.energy.energy(&p.state);
+        let report = NewtonReport {
+            converged: true,
+            iterations: p.iterations,
+            residual_history: vec![p.residual],
+            gradient_norm: p.residual,
+            energy,
+            factorizations: 0,
+        };
+        let mut eq = analyse(self.tracer.newton, &p.state, &report, &self.options.measure)?;
+        eq.branch = branch;
+        (self.observer)(eq)
+    }
+
+    fn in_range(&self, p: &Point) -> bool {
+        let v = self.tracer.parameter_of(&p.state);
+        v >= self.options.range[0] && v <= self.options.range[1]
+    }
+
+    /// Number of the next branch to be traced.
+    pub fn next_branch(&self) -> usize {
+        self.next_branch
+    }
+
+    /// Follow the branch through `state` in both directions (or one: sign ±1),
+    /// then, if asked, the branches bifurcating at its branch points.
+    pub fn run(&mut self, state: RodState, directions: &[f64]) -> Result<()> {
+        let branch = self.next_branch;
+        self.next_branch += 1;
+        for (k, &sign) in directions.iter().enumerate() {
+            let start = self.tracer.start(state.clone(), sign)?;
+            // the start point is emitted once
+            self.trace(start, branch, k == 0)?;
+        }
+        if self.options.switch_branches {
+            let bps = std::mem::take(&mut self.branch_points);
+            for (bp, null, _) in bps {
+                for sign in [1.0, -1.0] {
+                    let b = self.next_branch;
+                    self.next_branch += 1;
+                    let norm = self.tracer.weighted_norm(&null);
+                    let fake = Point {
+                        tangent_q: null.iter().map(|x| sign * x / norm).collect(),
+                        tangent_p: 0.0,
+                        ..bp.clone()
+                    };
+                    match self.tracer.correct(&fake, self.options.settings.step, None) {
+                        Ok(p) if self.in_range(&p) => {
+                            let mut trial = p.clone();
+                            // orient away from the branch point
+                            trial.tangent_q = p.tangent_q.clone();
+                            self.trace(trial, b, true)?;
+                        }
+                        Ok(_) => {}
+                        Err(e) => self.events.push(event(
+                            "end",
+                            &bp,
+                            b,
+                            format!("branch switch failed: {e}"),
+                        )),
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn trace(&mut self, start: Point, branch: usize, emit_start: bool) -> Result<()> {
+        let measure = self.options.measure;
+        let settings = self.options.settings.clone();
+        if emit_start {
+            self.emit(&start, branch)?;
+        }
+        let mut a = start;
+        let mut wa = watch(&a.state, &measure);
+        let mut ds = settings.step;
+        for _ in 0..settings.max_points {
+            if !self.in_range(&a) {
+                break;
+            }
+            let b = match self.tracer.correct(&a, ds, None) {
+                Ok(b) if b.iterations <= 6 && self.tracer_dot(&a, &b) > 0.9 => b,
+                _ => {
+                    ds *= 0.5;
+                    if ds < settings.min_step {
+                        self.events.push(event(
+                            "end",
+                            &a,
+                            branch,
+                            "step below min_step: branch lost".into(),
+                        ));
+                        break;
+                    }
+                    continue;
+                }
+            };
+            let wb = watch(&b.state, &measure);
+            if self.options.locate_events {
+                self.locate_events(&a, &b, &wa, &wb, ds, branch)?;
+            }
+            self.emit(&b, branch)?;
+            if b.iterations <= 3 {
+                ds = (ds * 1.5).min(settings.max_step);
+            }
+            a = b;
+            wa = wb;
+        }
+        Ok(())
+    }
+
+    fn tracer_dot(&self, a: &Point, b: &Point) -> f64 {
+        let w = 1.0 / a.tangent_q.len() as f64;
+        w * a
+            .tangent_q
+            .iter()
+            .zip(&b.tangent_q)
+            .map(|(x, y)| x * y)
+            .sum::<f64>()
+            + a.tangent_p * b.tangent_p
+    }
+
+    fn locate_events(
+        &mut self,
+        a: &Point,
+        b: &Point,
+        wa: &Watch,
+        wb: &Watch,
+        ds: f64,
+        branch: usize,
+    ) -> Result<()> {
+        let measure = self.options.measure;
+        let fold = a.tangent_p * b.tangent_p < 0.0;
+        if fold {
+            let s = a.tangent_p.signum();
+            let p = self.locate(a, ds, &mut |_, p| p.tangent_p.signum() == s)?;
+            let detail = format!(
+                "negative eigenvalues {} → {}",
+                a.negative_count, b.negative_count
+            );
+            self.events.push(event("fold", &p, branch, detail));
+        }
+        if a.negative_count != b.negative_count {
+            let na = a.negative_count;
+            let p = self.locate(a, ds, &mut |_, p| p.negative_count == na)?;
+            let detail = format!("negative eigenvalues {} → {}", na, b.negative_count);
+            self.events
+                .push(event("stability", &p, branch, detail.clone()));
+            if !fold {
+                let (lambda, null) = self.tracer.lowest_mode(&p)?;
+                self.events.push(event(
+                    "branch_point",
+                    &p,
+                    branch,
+                    format!("{detail}; eigenvalue there {lambda:.2e}"),
+                ));
+                self.branch_points.push((p, null, branch));
+            }
+        }
+        if (wa.wall > 0.0) != (wb.wall > 0.0) {
+            let inside = wa.wall > 0.0;
+            let p = self.locate(a, ds, &mut |_, p| {
+                (watch(&p.state, &measure).wall > 0.0) == inside
+            })?;
+            let detail = if inside {
+                "leaves the walls"
+            } else {
+                "enters the walls"
+            };
+            self.events.push(event("wall", &p, branch, detail.into()));
+        }
+        if wa.knot != wb.knot || (wb.link - wa.link).abs() > 1.0 {
+            let (ka, la) = (wa.knot, wa.link);
+            let p = self.locate(a, ds, &mut |_, p| {
+                let w = watch(&p.state, &measure);
+                w.knot == ka && (w.link - la).abs() < 1.0
+            })?;
+            let detail = format!(
+                "knot determinant {} → {}, link {:.3} → {:.3}",
+                wa.knot, wb.knot, wa.link, wb.link
+            );
+            self.events
+                .push(event("crossing", &p, branch, detail.clone()));
+            if wa.knot != wb.knot {
+                self.events.push(event("knot_change", &p, branch, detail));
+            }
+        }
+        Ok(())
+    }
+
+    fn locate(
+        &mut self,
+        from: &Point,
+        sigma: f64,
+        same: &mut dyn FnMut(&mut Tracer<'a>, &Point) -> bool,
+    ) -> Result<Point, ContinuationError> {
+        self.tracer.locate(from, sigma, same)
+    }
+}
+
+/// Label events as in the paper's figures: walls W1, W2, … by increasing φ on
+/// each branch, X for crossings, S for branch points, F for folds, J for jumps.
+pub fn label_events(events: &mut [Event]) {
+    let mut order: Vec<usize> = (0..events.len()).collect();
+    order.sort_by(|&i, &j| {
+        (
+            events[i].branch,
+            events[i].z_star.to_bits(),
+            events[i].phi_over_2pi,
+        )
+            .partial_cmp(&(
+                events[j].branch,
+                events[j].z_star.to_bits(),
+                events[j].phi_over_2pi,
+            ))
+            .unwrap()
+    });
+    let mut counters = std::collections::HashMap::<(usize, u64, &str), usize>::new();
+    for &i in &order {
+        let prefix = match events[i].kind.as_str() {
+            "wall" => "W",
+            "crossing" => "X",
+            "branch_point" => "S",
+            "fold" => "F",
+            "jump" => "J",
+            _ => continue,
+        };
+        let key = (events[i].branch, events[i].z_star.to_bits(), prefix);
+        let k = counters.entry(key).or_insert(0);
+        *k += 1;
+        events[i].label = if prefix == "W" || prefix == "F" || prefix == "J" || *k > 1 {
+            format!("{prefix}{k}")
+        } else {
+            prefix.to_string()
+        };
+    }
+}

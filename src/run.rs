@@ -1,0 +1,125 @@
+//! Running a scene: one equilibrium, or branches of equilibria (continuation,
+//! optionally swept over a second parameter).
+
+use crate::branch::{BranchOptions, BranchRun, Event, Observer, label_events};
+use crate::equilibrium::{Measure, analyse, initial_state};
+use crate::model::energy::RodEnergy;
+use crate::model::rod::{Parameter, RodState};
+use crate::scene::{Direction, Scene};
+use crate::solve::continuation::{ContinuationSettings, Point, Tracer};
+use crate::solve::newton::Newton;
+use anyhow::{Context, Result, bail};
+
+/// Move an equilibrium to `parameter = target` by continuation in that
+/// parameter (through folds if need be), ending with a Newton solve at exactly
+/// the target.
+pub fn reach(
+    newton: &mut Newton,
+    state: RodState,
+    parameter: Parameter,
+    target: f64,
+    settings: &ContinuationSettings,
+) -> Result<RodState> {
+    let mut tracer = Tracer::new(newton, parameter, settings.clone());
+    let now = parameter.value(&state.clamps);
+    if (target - now).abs() < 1e-14 {
+        return Ok(state);
+    }
+    let sign = (target - now).signum();
+    let mut a = tracer.start(state, sign)?;
+    let mut ds = settings.step;
+    for _ in 0..settings.max_points {
+        let pa = tracer.parameter_of(&a.state);
+        let b = match tracer.correct(&a, ds, None) {
+            Ok(b) if b.iterations <= 6 => b,
+            _ => {
+                ds *= 0.5;
+                if ds < settings.min_step {
+                    bail!(
+                        "could not reach {} = {target}: branch lost at {pa}",
+                        parameter.name()
+                    );
+                }
+                continue;
+            }
+        };
+        let pb = tracer.parameter_of(&b.state);
+        if (pb - target) * (pa - target) <= 0.0 {
+            // Newton at fixed parameter: a corrector along the parameter axis
+            let axis = Point {
+                tangent_q: vec![0.0; a.tangent_q.len()],
+                tangent_p: 1.0,
+                ..a.clone()
+            };
+            let p = tracer.correct(&axis, target - pa, None)?;
+            return Ok(p.state);
+        }
+        if b.iterations <= 3 {
+            ds = (ds * 1.5).min(settings.max_step);
+        }
+        a = b;
+    }
+    bail!(
+        "could not reach {} = {target} within {} steps",
+        parameter.name(),
+        settings.max_points
+    )
+}
+
+/// Run a scene at N segments (the scene's if None): every equilibrium goes to
+/// `observer` as soon as it is computed; returns the labelled events.
+pub fn run_scene(
+    scene: &Scene,
+    segments: Option<usize>,
+    observer: &mut Observer<'_>,
+) -> Result<Vec<Event>> {
+    let model = scene.rod_model(segments);
+    let mut state = initial_state(scene, &model)?;
+    let mut newton = Newton::new(RodEnergy::new(model));
+    let report = newton
+        .minimize(&mut state, &scene.solver)
+        .context("Newton minimisation")?;
+    let measure = Measure::of(scene);
+    let Some(spec) = &scene.continuation else {
+        observer(analyse(&mut newton, &state, &report, &measure)?)?;
+        return Ok(vec![]);
+    };
+    let defaults = ContinuationSettings::default();
+    let settings = ContinuationSettings {
+        step: spec.step.unwrap_or(defaults.step),
+        max_step: spec.max_step.unwrap_or(defaults.max_step),
+        max_points: spec.max_points.map_or(defaults.max_points, |m| m as usize),
+        ..defaults
+    };
+    let options = BranchOptions {
+        parameter: spec.parameter,
+        range: spec.range,
+        settings: settings.clone(),
+        locate_events: spec.locate_events,
+        switch_branches: spec.switch_branches,
+        measure,
+    };
+    let directions: &[f64] = match spec.direction {
+        Direction::Up => &[1.0],
+        Direction::Down => &[-1.0],
+        Direction::Both => &[1.0, -1.0],
+    };
+    let stops: Vec<Option<(Parameter, f64)>> = match &scene.sweep {
+        Some(sw) => sw.values.iter().map(|v| Some((sw.parameter, *v))).collect(),
+        None => vec![None],
+    };
+    let mut events = Vec::new();
+    let mut first_branch = 0;
+    for stop in stops {
+        if let Some((parameter, value)) = stop {
+            state = reach(&mut newton, state, parameter, value, &settings)
+                .with_context(|| format!("reaching {} = {value}", parameter.name()))?;
+        }
+        let mut run = BranchRun::new(&mut newton, options.clone(), &mut *observer, first_branch);
+        run.run(state.clone(), directions)?;
+        first_branch = run.next_branch();
+        events.extend(run.events);
+    }
+    label_events(&mut events);
+    Ok(events)
+}

@@ -1,0 +1,320 @@
+//! Pseudo-arclength continuation of equilibria, ∇E(q; p) = 0, in one clamp
+//! parameter p: tangent predictor, Newton corrector on the bordered system
+//! [H  ∂_p∇E; w τ_qᵀ  τ_p] (block elimination with the sparse LDLᵀ of H, which
+//! need not be definite), adaptive step, and location of events by bisection
+//! in arclength on a test function.
+
+use crate::model::rod::{Parameter, RodState};
+use crate::solve::newton::{Newton, SolveError};
+use serde::{Deserialize, Serialize};
+
+/// Settings of one continuation.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContinuationSettings {
+    /// Initial arclength step (≈ parameter step where the branch is flat).
+    pub step: f64,
+    /// Smallest step before giving up.
+    pub min_step: f64,
+    /// Largest step.
+    pub max_step: f64,
+    /// Most points on one branch direction.
+    pub max_points: usize,
+    /// Corrector tolerance on the relative gradient.
+    pub tolerance: f64,
+    /// Corrector iterations before the step is cut.
+    pub max_corrector_iterations: usize,
+    /// Events are located to this arclength.
+    pub locate_tolerance: f64,
+}
+
+impl Default for ContinuationSettings {
+    fn default() -> Self {
+        ContinuationSettings {
+            step: 0.005,
+            min_step: 1e-7,
+            max_step: 0.02,
+            max_points: 2000,
+            tolerance: 1e-10,
+            max_corrector_iterations: 10,
+            locate_tolerance: 1e-9,
+        }
+    }
+}
+
+/// A converged point of a branch with its unit tangent (weighted norm).
+#[derive(Clone, Debug)]
+pub struct Point {
+    /// The equilibrium.
+    pub state: RodState,
+    /// Tangent on the free dofs.
+    pub tangent_q: Vec<f64>,
+    /// Tangent component along the parameter (dp/ds).
+    pub tangent_p: f64,
+    /// Negative eigenvalues of the Hessian (LDLᵀ inertia).
+    pub negative_count: usize,
+    /// Corrector iterations it took.
+    pub iterations: usize,
+    /// Relative gradient at convergence.
+    pub residual: f64,
+}
+
+/// Why a continuation step failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ContinuationError {
+    /// The Hessian could not be factorised (exactly singular).
+    #[error("continuation: singular Hessian at {0}")]
+    Singular(&'static str),
+    /// The corrector did not converge.
+    #[error("continuation: corrector did not converge in {0} iterations")]
+    Corrector(usize),
+    /// Non-finite values.
+    #[error("continuation: non-finite value in {0}")]
+    NonFinite(&'static str),
+    /// A start state that is no equilibrium.
+    #[error(transparent)]
+    Newton(#[from] SolveError),
+}
+
+/// Traces branches of equilibria of one rod in one parameter.
+pub struct Tracer<'a> {
+    /// Energy, factorisation workspace.
+    pub newton: &'a mut Newton,
+    /// The continuation parameter.
+    pub parameter: Parameter,
+    /// Settings.
+    pub settings: ContinuationSettings,
+    grad: Vec<f64>,
+    values: Vec<f64>,
+    fp: Vec<f64>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    /// Weight of the dofs in the arclength norm (1/number of dofs).
+    weight: f64,
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+impl<'a> Tracer<'a> {
+    /// A tracer in `parameter`.
+    pub fn new(
+        newton: &'a mut Newton,
+        parameter: Parameter,
+        settings: ContinuationSettings,
+    ) -> Self {
+        let n = newton.energy.map.len();
+        Tracer {
+            newton,
+            parameter,
+            settings,
+            grad: vec![0.0; n],
+            values: vec![],
+            fp: vec![0.0; n],
+            a: vec![0.0; n],
+            b: vec![0.0; n],
+            weight: 1.0 / n as f64,
+        }
+    }
+
+    /// Parameter value of a state.
+    pub fn parameter_of(&self, state: &RodState) -> f64 {
+        self.parameter.value(&state.clamps)
+    }
+
+    /// Evaluate gradient, Hessian, ∂_p∇E at `state` and factor H. Returns the
+    /// relative gradient and the round-off floor test.
+    fn linearise(&mut self, state: &RodState) -> Result<(f64, bool), ContinuationError> {
+        let energy = &self.newton.energy;
+        self.values.resize(energy.pattern.nnz(), 0.0);
+        let info = energy.hessian(state, &mut self.grad, &mut self.values);
+        let velocity = self.parameter.velocity(&state.clamps);
+        energy.gradient_parameter_derivative(state, &velocity, &mut self.fp);
+        let gnorm = dot(&self.grad, &self.grad).sqrt();
+        if !gnorm.is_finite() || self.values.iter().any(|v| !v.is_finite()) {
+            return Err(ContinuationError::NonFinite("gradient/Hessian"));
+        }
+        let rel = if info.force_scale > 1e-300 {
+            gnorm / info.force_scale
+        } else {
+            0.0
+        };
+        let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
+        let max_diag = energy
+            .pattern
+            .diagonal
+            .iter()
+            .map(|&s| self.values[s].abs())
+            .fold(0.0, f64::max);
+        let floor =
+            16.0 * f64::EPSILON * max_diag * extent.max(1e-3) * (self.grad.len() as f64).sqrt();
+        self.newton
+            .ldlt
+            .factor(&self.values)
+            .map_err(|_| ContinuationError::Singular("linearisation"))?;
+        Ok((rel, gnorm <= floor))
+    }
+
+    /// Tangent at a converged state (factorisation of `linearise` in place):
+    /// (v, 1) with H v = -∂_p∇E, normalised, oriented along `orient`.
+    fn tangent(&mut self, orient: Option<(&[f64], f64)>, sign: f64) -> (Vec<f64>, f64) {
+        self.b.copy_from_slice(&self.fp);
+        self.newton.ldlt.solve_in_place(&mut self.b);
+        let v: Vec<f64> = self.b.iter().map(|x| -x).collect();
+        let norm = (self.weight * dot(&v, &v) + 1.0).sqrt();
+        let mut tq: Vec<f64> = v.iter().map(|x| x / norm).collect();
+        let mut tp = 1.0 / norm;
+        let s = match orient {
+            Some((q, p)) => self.weight * dot(&tq, q) + tp * p,
+            None => sign,
+        };
+        if s < 0.0 {
+            tq.iter_mut().for_each(|x| *x = -*x);
+            tp = -tp;
+        }
+        (tq, tp)
+    }
+
+    /// A branch point from an equilibrium `state`, its tangent oriented so that
+    /// the parameter moves in the direction of `sign` (±1).
+    pub fn start(&mut self, state: RodState, sign: f64) -> Result<Point, ContinuationError> {
+        let (residual, _) = self.linearise(&state)?;
+        let negative_count = self.newton.ldlt.negative_count();
+        let (tangent_q, tangent_p) = self.tangent(None, sign);
+        Ok(Point {
+            state,
+            tangent_q,
+            tangent_p,
+            negative_count,
+            iterations: 0,
+            residual,
+        })
+    }
+
+    /// The point at arclength `sigma` from `from` along its tangent direction
+    /// (`direction` overrides the tangent, e.g. a null vector at a branch point).
+    pub fn correct(
+        &mut self,
+        from: &Point,
+        sigma: f64,
+        direction: Option<(&[f64], f64)>,
+    ) -> Result<Point, ContinuationError> {
+        let (tq, tp) = direction.unwrap_or((&from.tangent_q, from.tangent_p));
+        let tq = tq.to_vec();
+        let map = self.newton.energy.map;
+        let p_pred = self.parameter_of(&from.state) + sigma * tp;
+        let mut state = from.state.clone();
+        state.set_clamps(self.parameter.with(&state.clamps, p_pred));
+        let pred_step: Vec<f64> = tq.iter().map(|x| sigma * x).collect();
+        state = state.displaced(&map, &pred_step);
+        let mut offset = vec![0.0; tq.len()];
+        let mut p = p_pred;
+        for it in 0..=self.settings.max_corrector_iterations {
+            let (rel, at_floor) = self.linearise(&state)?;
+            let c = self.weight * dot(&tq, &offset) + tp * (p - p_pred);
+            if (rel <= self.settings.tolerance || at_floor)
+                && c.abs() <= 1e-10 * sigma.abs().max(1e-12)
+            {
+                let negative_count = self.newton.ldlt.negative_count();
+                let orient = (from.tangent_q.as_slice(), from.tangent_p);
+                let (tangent_q, tangent_p) = self.tangent(Some(orient), 1.0);
+                return Ok(Point {
+                    state,
+                    tangent_q,
+                    tangent_p,
+                    negative_count,
+                    iterations: it,
+                    residual: rel,
+                });
+            }
+            if it == self.settings.max_corrector_iterations {
+                break;
+            }
+            self.a.copy_from_slice(&self.grad);
+            self.newton.ldlt.solve_in_place(&mut self.a);
+            self.b.copy_from_slice(&self.fp);
+            self.newton.ldlt.solve_in_place(&mut self.b);
+            let denom = tp - self.weight * dot(&tq, &self.b);
+            let dp = (-c + self.weight * dot(&tq, &self.a)) / denom;
+            if !dp.is_finite() {
+                return Err(ContinuationError::NonFinite("corrector"));
+            }
+            let dq: Vec<f64> = self
+                .a
+                .iter()
+                .zip(&self.b)
+                .map(|(a, b)| -a - dp * b)
+                .collect();
+            // a corrector that moves far is not converging to this branch
+            let largest = (0..dq.len())
+                .filter(|&d| map.is_translation(d))
+                .map(|d| dq[d].abs())
+                .fold(0.0, f64::max);
+            if largest > 0.05 || dq.iter().any(|v| !v.is_finite()) {
+                return Err(ContinuationError::Corrector(it + 1));
+            }
+            p += dp;
+            state.set_clamps(self.parameter.with(&state.clamps, p));
+            state = state.displaced(&map, &dq);
+            offset.iter_mut().zip(&dq).for_each(|(o, d)| *o += d);
+        }
+        Err(ContinuationError::Corrector(
+            self.settings.max_corrector_iterations,
+        ))
+    }
+
+    /// Bisection in arclength on (0, sigma) for the change of a predicate that
+    /// holds at `from` and fails at the point `sigma` away: returns the first
+    /// point where it fails, within `locate_tolerance` in arclength.
+    pub fn locate(
+        &mut self,
+        from: &Point,
+        sigma: f64,
+        same: &mut dyn FnMut(&mut Self, &Point) -> bool,
+    ) -> Result<Point, ContinuationError> {
+        let (mut lo, mut hi) = (0.0, sigma);
+        let mut last = None;
+        while (hi - lo).abs() > self.settings.locate_tolerance {
+            let mid = 0.5 * (lo + hi);
+            let p = self.correct(from, mid, None)?;
+            if same(self, &p) {
+                lo = mid;
+            } else {
+                hi = mid;
+                last = Some(p);
+            }
+        }
+        match last {
+            Some(p) => Ok(p),
+            None => self.correct(from, hi, None),
+        }
+    }
+
+    /// Lowest eigenvalue and its eigenvector of the Hessian at a point.
+    pub fn lowest_mode(&mut self, point: &Point) -> Result<(f64, Vec<f64>), ContinuationError> {
+        let energy = &self.newton.energy;
+        self.values.resize(energy.pattern.nnz(), 0.0);
+        energy.hessian(&point.state, &mut self.grad, &mut self.values);
+        let sp = crate::stability::lowest_eigenvalues(
+            &energy.pattern,
+            &self.values,
+            None,
+            2,
+            &mut self.newton.ldlt,
+        )
+        .map_err(|_| ContinuationError::Singular("lowest mode"))?;
+        // the mode nearest zero (at a branch point one eigenvalue vanishes)
+        let k = if sp.values.len() > 1 && sp.values[1].abs() < sp.values[0].abs() {
+            1
+        } else {
+            0
+        };
+        Ok((sp.values[k], sp.vectors[k].clone()))
+    }
+
+    /// Weighted norm of a dof vector.
+    pub fn weighted_norm(&self, q: &[f64]) -> f64 {
+        (self.weight * dot(q, q)).sqrt()
+    }
+}
