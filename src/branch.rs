@@ -39,13 +39,27 @@ struct Watch {
     link: f64,
 }
 
-fn watch(state: &RodState, measure: &Measure) -> Watch {
-    let shape = Shape::of(state, measure);
-    Watch {
-        wall: shape.wall_distance,
-        knot: shape.knot.determinant,
-        link: state.twist() + shape.writhe,
+impl Watch {
+    fn of(eq: &Equilibrium) -> Watch {
+        Watch {
+            wall: eq.wall_distance,
+            knot: eq.knot_determinant,
+            link: eq.link,
+        }
     }
+}
+
+/// Wall clearance of a state (the cheap part of [`Shape`]).
+fn wall_of(state: &RodState) -> f64 {
+    let (points, _) = state.centreline();
+    let heights: Vec<f64> = points[1..points.len() - 1].iter().map(|p| p.z).collect();
+    crate::geometry::walls::wall_clearance(&heights, state.clamps.z_star)
+}
+
+/// Knot determinant and link of a state.
+fn knot_of(state: &RodState, measure: &Measure) -> (u64, f64) {
+    let shape = Shape::of(state, measure);
+    (shape.knot.determinant, state.twist() + shape.writhe)
 }
 
 /// What the caller gets for every accepted point.
@@ -112,7 +126,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         }
     }
 
-    fn emit(&mut self, p: &Point, branch: usize) -> Result<()> {
+    fn measure(&mut self, p: &Point, branch: usize, leg: usize) -> Result<Equilibrium> {
         let energy = self.tracer.newton.energy.energy(&p.state);
         let report = NewtonReport {
             converged: true,
@@ -124,7 +138,8 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         };
         let mut eq = analyse(self.tracer.newton, &p.state, &report, &self.options.measure)?;
         eq.branch = branch;
-        (self.observer)(eq)
+        eq.leg = leg;
+        Ok(eq)
     }
 
     fn in_range(&self, p: &Point) -> bool {
@@ -145,7 +160,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         for (k, &sign) in directions.iter().enumerate() {
             let start = self.tracer.start(state.clone(), sign)?;
             // the start point is emitted once
-            self.trace(start, branch, k == 0)?;
+            self.trace(start, branch, k, k == 0)?;
         }
         if self.options.switch_branches {
             let bps = std::mem::take(&mut self.branch_points);
@@ -160,12 +175,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                         ..bp.clone()
                     };
                     match self.tracer.correct(&fake, self.options.settings.step, None) {
-                        Ok(p) if self.in_range(&p) => {
-                            let mut trial = p.clone();
-                            // orient away from the branch point
-                            trial.tangent_q = p.tangent_q.clone();
-                            self.trace(trial, b, true)?;
-                        }
+                        Ok(p) if self.in_range(&p) => self.trace(p, b, 0, true)?,
                         Ok(_) => {}
                         Err(e) => self.events.push(event(
                             "end",
@@ -180,14 +190,14 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         Ok(())
     }
 
-    fn trace(&mut self, start: Point, branch: usize, emit_start: bool) -> Result<()> {
-        let measure = self.options.measure;
+    fn trace(&mut self, start: Point, branch: usize, leg: usize, emit_start: bool) -> Result<()> {
         let settings = self.options.settings.clone();
+        let eq = self.measure(&start, branch, leg)?;
+        let mut wa = Watch::of(&eq);
         if emit_start {
-            self.emit(&start, branch)?;
+            (self.observer)(eq)?;
         }
         let mut a = start;
-        let mut wa = watch(&a.state, &measure);
         let mut ds = settings.step;
         for _ in 0..settings.max_points {
             if !self.in_range(&a) {
@@ -209,11 +219,12 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                     continue;
                 }
             };
-            let wb = watch(&b.state, &measure);
+            let eq = self.measure(&b, branch, leg)?;
+            let wb = Watch::of(&eq);
             if self.options.locate_events {
                 self.locate_events(&a, &b, &wa, &wb, ds, branch)?;
             }
-            self.emit(&b, branch)?;
+            (self.observer)(eq)?;
             if b.iterations <= 3 {
                 ds = (ds * 1.5).min(settings.max_step);
             }
@@ -273,9 +284,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         }
         if (wa.wall > 0.0) != (wb.wall > 0.0) {
             let inside = wa.wall > 0.0;
-            let p = self.locate(a, ds, &mut |_, p| {
-                (watch(&p.state, &measure).wall > 0.0) == inside
-            })?;
+            let p = self.locate(a, ds, &mut |_, p| (wall_of(&p.state) > 0.0) == inside)?;
             let detail = if inside {
                 "leaves the walls"
             } else {
@@ -286,8 +295,8 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         if wa.knot != wb.knot || (wb.link - wa.link).abs() > 1.0 {
             let (ka, la) = (wa.knot, wa.link);
             let p = self.locate(a, ds, &mut |_, p| {
-                let w = watch(&p.state, &measure);
-                w.knot == ka && (w.link - la).abs() < 1.0
+                let (knot, link) = knot_of(&p.state, &measure);
+                knot == ka && (link - la).abs() < 1.0
             })?;
             let detail = format!(
                 "knot determinant {} → {}, link {:.3} → {:.3}",
@@ -313,8 +322,15 @@ impl<'a, 'r> BranchRun<'a, 'r> {
 }
 
 /// Label events as in the paper's figures: walls W1, W2, … by increasing φ on
-/// each branch, X for crossings, S for branch points, F for folds, J for jumps.
+/// each branch, S for branch points, F for folds, J for jumps, and X, X2, …
+/// for crossings in the order met from the start of the branch.
 pub fn label_events(events: &mut [Event]) {
+    let mut crossings = std::collections::HashMap::<(usize, u64), usize>::new();
+    for e in events.iter_mut().filter(|e| e.kind == "crossing") {
+        let k = crossings.entry((e.branch, e.z_star.to_bits())).or_insert(0);
+        *k += 1;
+        e.label = if *k == 1 { "X".into() } else { format!("X{k}") };
+    }
     let mut order: Vec<usize> = (0..events.len()).collect();
     order.sort_by(|&i, &j| {
         (
@@ -339,6 +355,9 @@ pub fn label_events(events: &mut [Event]) {
             "jump" => "J",
             _ => continue,
         };
+        if prefix == "X" {
+            continue;
+        }
         let key = (events[i].branch, events[i].z_star.to_bits(), prefix);
         let k = counters.entry(key).or_insert(0);
         *k += 1;

@@ -4,6 +4,7 @@ use crate::geometry::closure::{extent, ray_closure};
 use crate::geometry::knot::knot_type;
 use crate::geometry::polyline::read_points;
 use crate::geometry::writhe::writhe_closed;
+use crate::plot::bifurcation_diagram;
 use crate::run::run_scene;
 use crate::scene::Scene;
 use crate::summary::{Summary, print_equilibrium, print_events};
@@ -52,6 +53,14 @@ pub enum Command {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// Redraw the bifurcation diagram of a run's JSON summary.
+    Plot {
+        /// The summary (written by `run --json`).
+        summary: PathBuf,
+        /// Output stem (default: the summary's path without extension).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Regenerate the validation report (docs/validation.md) on stdout.
     Validate {
         /// Folder holding the scenes.
@@ -92,6 +101,18 @@ pub fn main_with(cli: Cli) -> Result<()> {
             rays,
             json,
         } => knot(&curve, closed, rays, json),
+        Command::Plot { summary, out } => {
+            let text = std::fs::read_to_string(&summary)
+                .with_context(|| format!("cannot read {}", summary.display()))?;
+            let s: Summary = serde_json::from_str(&text)
+                .with_context(|| format!("{} is not a knotrod summary", summary.display()))?;
+            let stem = out.unwrap_or_else(|| summary.with_extension(""));
+            let title = format!("{} (N = {})", s.scene, s.segments);
+            for f in bifurcation_diagram(&stem, &title, &s.equilibria, &s.events)? {
+                writeln!(std::io::stdout().lock(), "plot written to {}", f.display())?;
+            }
+            Ok(())
+        }
         Command::Validate { scenes } => {
             write!(std::io::stdout().lock(), "{}", validation::report(&scenes)?)?;
             Ok(())
@@ -182,6 +203,16 @@ fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()
         }
     } else {
         print_events(&summary.events, &mut out)?;
+        let stem = json
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("recordings").join(&summary.scene));
+        if let Some(dir) = stem.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)?;
+        }
+        let title = format!("{} (N = {})", summary.scene, summary.segments);
+        for f in bifurcation_diagram(&stem, &title, &summary.equilibria, &summary.events)? {
+            writeln!(out, "plot written to {}", f.display())?;
+        }
     }
     // the summary is written whatever happened, with what was computed
     if let Some(path) = &json {

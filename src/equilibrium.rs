@@ -80,6 +80,10 @@ pub struct Equilibrium {
     /// Branch this equilibrium lies on (0 for a single solve).
     #[serde(default)]
     pub branch: usize,
+    /// Leg of the branch: 0 from the start in the first direction, 1 in the
+    /// other (whose first point follows the branch's start).
+    #[serde(default)]
+    pub leg: usize,
     /// The full discrete state (restart with `[initial] shape = "file"`).
     pub state: RodState,
 }
@@ -268,6 +272,7 @@ pub fn analyse(
         wall_distance: shape.wall_distance,
         ray_distance: shape.ray_distance,
         branch: 0,
+        leg: 0,
         state: state.clone(),
     })
 }

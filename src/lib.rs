@@ -7,6 +7,7 @@ pub mod cli;
 pub mod equilibrium;
 pub mod geometry;
 pub mod model;
+pub mod plot;
 pub mod run;
 pub mod scene;
 pub mod solve;

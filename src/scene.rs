@@ -453,10 +453,10 @@ impl Scene {
                     positive(field, v)?;
                 }
             }
-            if let Some(m) = c.max_points {
-                if m < 1 {
-                    return Err(invalid("continuation.max_points", "must be >= 1"));
-                }
+            if let Some(m) = c.max_points
+                && m < 1
+            {
+                return Err(invalid("continuation.max_points", "must be >= 1"));
             }
         }
         if let Some(sw) = &self.sweep {

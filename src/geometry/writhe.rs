@@ -31,7 +31,11 @@ pub fn segment_pair_writhe(
         // a degenerate quadrilateral (coplanar or touching): no solid angle
         return 0.0;
     };
-    let asin = |x: f64| x.clamp(-1.0, 1.0).asin();
+    // asin via atan2: accurate near ±1 and free of libm slow paths
+    let asin = |x: f64| {
+        let x = x.clamp(-1.0, 1.0);
+        x.atan2(((1.0 - x) * (1.0 + x)).sqrt())
+    };
     let omega = asin(n1.dot(&n2)) + asin(n2.dot(&n3)) + asin(n3.dot(&n4)) + asin(n4.dot(&n1));
     let sign = (p4 - p3).cross(&(p2 - p1)).dot(&r13);
     if sign > 0.0 {

@@ -75,23 +75,51 @@ impl VertexFrames {
     }
 }
 
-/// Local variables of vertex i: x_{i-1}, x_i, x_{i+1}, θ_{i-1}, θ_i.
-pub fn vertex_variables(state: &RodState, i: usize) -> [f64; 11] {
-    let mut q = [0.0; 11];
-    for (k, node) in [i - 1, i, i + 1].into_iter().enumerate() {
-        q[3 * k..3 * k + 3].copy_from_slice(state.nodes[node].as_slice());
-    }
-    q[9] = state.theta[i - 1];
-    q[10] = state.theta[i];
+/// Local variables of vertex i: its two edges e_{i-1}, e_i and angles
+/// θ_{i-1}, θ_i (the energy depends on the nodes only through the edges, so
+/// derivatives are taken in these 8 variables and mapped to the 11 node ones).
+pub fn vertex_variables(state: &RodState, i: usize) -> [f64; 8] {
+    let mut q = [0.0; 8];
+    q[0..3].copy_from_slice((state.nodes[i] - state.nodes[i - 1]).as_slice());
+    q[3..6].copy_from_slice((state.nodes[i + 1] - state.nodes[i]).as_slice());
+    q[6] = state.theta[i - 1];
+    q[7] = state.theta[i];
     q
 }
 
-/// Local variables of edge j: x_j, x_{j+1}.
-pub fn edge_variables(state: &RodState, j: usize) -> [f64; 6] {
-    let mut q = [0.0; 6];
-    q[0..3].copy_from_slice(state.nodes[j].as_slice());
-    q[3..6].copy_from_slice(state.nodes[j + 1].as_slice());
-    q
+/// Local variable of edge j: the edge vector x_{j+1} - x_j.
+pub fn edge_variables(state: &RodState, j: usize) -> [f64; 3] {
+    let e = state.nodes[j + 1] - state.nodes[j];
+    [e.x, e.y, e.z]
+}
+
+/// Node-variable index (x_{i-1}, x_i, x_{i+1}, θ_{i-1}, θ_i: 11) → list of
+/// (edge-variable index, coefficient) with e_{i-1} = x_i − x_{i−1}, e_i = x_{i+1} − x_i.
+fn vertex_chain(a: usize) -> [(usize, f64); 2] {
+    match a {
+        0..=2 => [(a, -1.0), (usize::MAX, 0.0)],
+        3..=5 => [(a - 3, 1.0), (a, -1.0)],
+        6..=8 => [(a - 3, 1.0), (usize::MAX, 0.0)],
+        9 => [(6, 1.0), (usize::MAX, 0.0)],
+        _ => [(7, 1.0), (usize::MAX, 0.0)],
+    }
+}
+
+/// Map an 8-variable gradient and Hessian to the 11 node variables.
+fn vertex_to_nodes(g8: &[f64], h8: &[f64]) -> ([f64; 11], [f64; 121]) {
+    let mut g = [0.0; 11];
+    let mut h = [0.0; 121];
+    for a in 0..11 {
+        for &(i, alpha) in vertex_chain(a).iter().filter(|c| c.0 != usize::MAX) {
+            g[a] += alpha * g8[i];
+            for b in 0..11 {
+                for &(j, beta) in vertex_chain(b).iter().filter(|c| c.0 != usize::MAX) {
+                    h[a * 11 + b] += alpha * beta * h8[i * 8 + j];
+                }
+            }
+        }
+    }
+    (g, h)
 }
 
 struct VertexGeometry<T> {
@@ -104,11 +132,8 @@ struct VertexGeometry<T> {
 }
 
 fn vertex_geometry<T: Scalar>(q: &[T], c: &VertexFrames) -> VertexGeometry<T> {
-    let x0 = [q[0], q[1], q[2]];
-    let x1 = [q[3], q[4], q[5]];
-    let x2 = [q[6], q[7], q[8]];
-    let e0 = frames::sub(x1, x0);
-    let e1 = frames::sub(x2, x1);
+    let e0 = [q[0], q[1], q[2]];
+    let e1 = [q[3], q[4], q[5]];
     let t0 = frames::scale(frames::norm(e0).recip(), e0);
     let t1 = frames::scale(frames::norm(e1).recip(), e1);
     let a0 = frames::parallel_transport(lift(&c.a_prev), lift(&c.t_prev), t0);
@@ -128,8 +153,8 @@ pub fn bending_energy<T: Scalar>(q: &[T], c: &VertexFrames, model: &RodModel) ->
 }
 
 fn bending_from<T: Scalar>(g: &VertexGeometry<T>, q: &[T], model: &RodModel) -> T {
-    let (d1a, d2a) = frames::material_directors(g.t0, g.a0, q[9]);
-    let (d1b, d2b) = frames::material_directors(g.t1, g.a1, q[10]);
+    let (d1a, d2a) = frames::material_directors(g.t0, g.a0, q[6]);
+    let (d1b, d2b) = frames::material_directors(g.t1, g.a1, q[7]);
     let k1 = frames::dot(g.kb, frames::add(d1a, d1b)) * 0.5;
     let k2 = frames::dot(g.kb, frames::add(d2a, d2b)) * 0.5;
     (k1 * k1 + k2 * k2 * model.k2) * (0.5 / model.segment_length())
@@ -147,7 +172,7 @@ fn twist_from<T: Scalar>(g: &VertexGeometry<T>, q: &[T], c: &VertexFrames) -> T 
     let ut = frames::parallel_transport(g.a0, g.t0, g.t1);
     let ut = frames::rotate_about(ut, g.t1, r);
     let reference = r + frames::signed_angle(ut, g.a1, g.t1);
-    q[10] - q[9] + reference
+    q[7] - q[6] + reference
 }
 
 /// Twisting energy at one vertex: K3 m² / (2h).
@@ -156,10 +181,10 @@ pub fn twisting_energy<T: Scalar>(q: &[T], c: &VertexFrames, model: &RodModel) -
     m * m * (0.5 * model.k3 / model.segment_length())
 }
 
-/// Stretching energy of one edge: S h/2 (|e|/h - 1)².
+/// Stretching energy of one edge (variables: the edge vector): S h/2 (|e|/h - 1)².
 pub fn stretching_energy<T: Scalar>(q: &[T], model: &RodModel) -> T {
     let h = model.segment_length();
-    let e = [q[3] - q[0], q[4] - q[1], q[5] - q[2]];
+    let e = [q[0], q[1], q[2]];
     let strain = frames::norm(e) * (1.0 / h) - 1.0;
     strain * strain * (0.5 * model.stretching_stiffness * h)
 }
@@ -253,6 +278,72 @@ impl RodEnergy {
         e
     }
 
+    /// Energy, node-variable gradient and Hessian (row-major 11×11) of the
+    /// bending and twisting at vertex i.
+    pub fn vertex_local(&self, state: &RodState, i: usize) -> (f64, [f64; 11], [f64; 121]) {
+        let c = VertexFrames::at(state, i);
+        let q = SVector::<f64, 8>::from(vertex_variables(state, i));
+        let (e, g8, h8) = num_dual::hessian(
+            |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms),
+            &q,
+        );
+        let (g, h) = vertex_to_nodes(g8.as_slice(), h8.as_slice());
+        (e, g, h)
+    }
+
+    /// Energy, node-variable gradient and Hessian (row-major 6×6) of the
+    /// stretching of edge j.
+    pub fn edge_local(&self, state: &RodState, j: usize) -> (f64, [f64; 6], [f64; 36]) {
+        let q = SVector::<f64, 3>::from(edge_variables(state, j));
+        let (e, g3, h3) = num_dual::hessian(
+            |v: SVector<_, 3>| stretching_energy(v.as_slice(), &self.model),
+            &q,
+        );
+        let mut g = [0.0; 6];
+        let mut h = [0.0; 36];
+        for a in 0..3 {
+            g[a] = -g3[a];
+            g[3 + a] = g3[a];
+            for b in 0..3 {
+                let v = h3[(a, b)];
+                h[a * 6 + b] = v;
+                h[(3 + a) * 6 + 3 + b] = v;
+                h[a * 6 + 3 + b] = -v;
+                h[(3 + a) * 6 + b] = -v;
+            }
+        }
+        (e, g, h)
+    }
+
+    fn vertex_gradient(&self, state: &RodState, i: usize) -> (f64, [f64; 11]) {
+        let c = VertexFrames::at(state, i);
+        let q = SVector::<f64, 8>::from(vertex_variables(state, i));
+        let (e, g8) = num_dual::gradient(
+            |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms),
+            &q,
+        );
+        let mut g = [0.0; 11];
+        for (a, ga) in g.iter_mut().enumerate() {
+            for &(k, alpha) in vertex_chain(a).iter().filter(|c| c.0 != usize::MAX) {
+                *ga += alpha * g8[k];
+            }
+        }
+        (e, g)
+    }
+
+    fn edge_gradient(&self, state: &RodState, j: usize) -> (f64, [f64; 6]) {
+        let h = self.model.segment_length();
+        let e = state.nodes[j + 1] - state.nodes[j];
+        let len = e.norm();
+        // S h/2 (|e|/h - 1)²: gradient S (|e|/h - 1) e/|e| on x_{j+1}
+        let f = self.model.stretching_stiffness * (len / h - 1.0) / len;
+        let energy = 0.5 * self.model.stretching_stiffness * h * (len / h - 1.0).powi(2);
+        (
+            energy,
+            [-f * e.x, -f * e.y, -f * e.z, f * e.x, f * e.y, f * e.z],
+        )
+    }
+
     /// Gradient with respect to all nodes and angles (clamp dofs included).
     pub fn full_gradient(&self, state: &RodState) -> FullGradient {
         let n = self.model.segments;
@@ -262,12 +353,7 @@ impl RodEnergy {
         };
         if self.terms.bending || self.terms.twisting {
             for i in 1..=n {
-                let c = VertexFrames::at(state, i);
-                let q = SVector::<f64, 11>::from(vertex_variables(state, i));
-                let (_, gl) = num_dual::gradient(
-                    |v| vertex_energy(v.as_slice(), &c, &self.model, self.terms),
-                    &q,
-                );
+                let (_, gl) = self.vertex_gradient(state, i);
                 for k in 0..3 {
                     g.nodes[i - 1 + k] += Vector3::new(gl[3 * k], gl[3 * k + 1], gl[3 * k + 2]);
                 }
@@ -277,9 +363,7 @@ impl RodEnergy {
         }
         if self.terms.stretching {
             for j in 1..n {
-                let q = SVector::<f64, 6>::from(edge_variables(state, j));
-                let (_, gl) =
-                    num_dual::gradient(|v| stretching_energy(v.as_slice(), &self.model), &q);
+                let (_, gl) = self.edge_gradient(state, j);
                 g.nodes[j] += Vector3::new(gl[0], gl[1], gl[2]);
                 g.nodes[j + 1] += Vector3::new(gl[3], gl[4], gl[5]);
             }
@@ -289,73 +373,57 @@ impl RodEnergy {
 
     /// Gradient on the free dofs (into `grad`), with energy and force scale.
     pub fn gradient(&self, state: &RodState, grad: &mut [f64]) -> GradientInfo {
-        self.evaluate(state, grad, None)
-    }
-
-    /// Gradient and Hessian (upper values on `self.pattern`) on the free dofs.
-    pub fn hessian(&self, state: &RodState, grad: &mut [f64], values: &mut [f64]) -> GradientInfo {
-        self.evaluate(state, grad, Some(values))
-    }
-
-    fn evaluate(
-        &self,
-        state: &RodState,
-        grad: &mut [f64],
-        mut values: Option<&mut [f64]>,
-    ) -> GradientInfo {
         let n = self.model.segments;
         grad.iter_mut().for_each(|v| *v = 0.0);
-        if let Some(v) = values.as_deref_mut() {
-            v.iter_mut().for_each(|x| *x = 0.0);
-        }
-        let mut energy = 0.0;
-        let mut scale2 = 0.0;
+        let (mut energy, mut scale2) = (0.0, 0.0);
         if self.terms.bending || self.terms.twisting {
             for i in 1..=n {
-                let c = VertexFrames::at(state, i);
-                let q = SVector::<f64, 11>::from(vertex_variables(state, i));
-                let dofs = self.map.vertex_stencil(i);
-                let f =
-                    |v: SVector<_, 11>| vertex_energy(v.as_slice(), &c, &self.model, self.terms);
-                match values.as_deref_mut() {
-                    Some(vals) => {
-                        let (e, gl, hl) = num_dual::hessian(f, &q);
-                        energy += e;
-                        scale2 += scatter(&dofs, gl.as_slice(), grad);
-                        scatter_hessian(&self.pattern.slots[i - 1], 11, hl.as_slice(), vals);
-                    }
-                    None => {
-                        let (e, gl) = num_dual::gradient(
-                            |v| vertex_energy(v.as_slice(), &c, &self.model, self.terms),
-                            &q,
-                        );
-                        energy += e;
-                        scale2 += scatter(&dofs, gl.as_slice(), grad);
-                    }
-                }
+                let (e, gl) = self.vertex_gradient(state, i);
+                energy += e;
+                scale2 += scatter(&self.map.vertex_stencil(i), &gl, grad);
             }
         }
         if self.terms.stretching {
             for j in 1..n {
-                let q = SVector::<f64, 6>::from(edge_variables(state, j));
-                let dofs = self.map.edge_stencil(j);
-                let f = |v: SVector<_, 6>| stretching_energy(v.as_slice(), &self.model);
-                match values.as_deref_mut() {
-                    Some(vals) => {
-                        let (e, gl, hl) = num_dual::hessian(f, &q);
-                        energy += e;
-                        scale2 += scatter(&dofs, gl.as_slice(), grad);
-                        scatter_hessian(&self.pattern.slots[n + j - 1], 6, hl.as_slice(), vals);
-                    }
-                    None => {
-                        let (e, gl) = num_dual::gradient(
-                            |v| stretching_energy(v.as_slice(), &self.model),
-                            &q,
-                        );
-                        energy += e;
-                        scale2 += scatter(&dofs, gl.as_slice(), grad);
-                    }
-                }
+                let (e, gl) = self.edge_gradient(state, j);
+                energy += e;
+                scale2 += scatter(&self.map.edge_stencil(j), &gl, grad);
+            }
+        }
+        GradientInfo {
+            energy,
+            force_scale: scale2.sqrt(),
+        }
+    }
+
+    /// Gradient and Hessian (upper values on `self.pattern`) on the free dofs.
+    /// The stencils are evaluated in parallel, then scattered in order (so the
+    /// result does not depend on the number of threads).
+    pub fn hessian(&self, state: &RodState, grad: &mut [f64], values: &mut [f64]) -> GradientInfo {
+        use rayon::prelude::*;
+        let n = self.model.segments;
+        grad.iter_mut().for_each(|v| *v = 0.0);
+        values.iter_mut().for_each(|x| *x = 0.0);
+        let (mut energy, mut scale2) = (0.0, 0.0);
+        if self.terms.bending || self.terms.twisting {
+            let local: Vec<(f64, [f64; 11], [f64; 121])> = (1..n + 1)
+                .into_par_iter()
+                .with_min_len(16)
+                .map(|i| self.vertex_local(state, i))
+                .collect();
+            for (k, (e, gl, hl)) in local.iter().enumerate() {
+                let i = k + 1;
+                energy += e;
+                scale2 += scatter(&self.map.vertex_stencil(i), gl, grad);
+                scatter_hessian(&self.pattern.slots[i - 1], 11, hl, values);
+            }
+        }
+        if self.terms.stretching {
+            for j in 1..n {
+                let (e, gl, hl) = self.edge_local(state, j);
+                energy += e;
+                scale2 += scatter(&self.map.edge_stencil(j), &gl, grad);
+                scatter_hessian(&self.pattern.slots[n + j - 1], 6, &hl, values);
             }
         }
         GradientInfo {
@@ -453,12 +521,7 @@ impl RodEnergy {
         let e = velocity.end;
         if self.terms.bending || self.terms.twisting {
             for i in [n - 1, n] {
-                let c = VertexFrames::at(state, i);
-                let q = SVector::<f64, 11>::from(vertex_variables(state, i));
-                let (_, _, hl) = num_dual::hessian(
-                    |v: SVector<_, 11>| vertex_energy(v.as_slice(), &c, &self.model, self.terms),
-                    &q,
-                );
+                let (_, _, hl) = self.vertex_local(state, i);
                 // local velocity: nodes i-1, i, i+1 and angles i-1, i
                 let mut vel = [0.0; 11];
                 for (k, node) in [i - 1, i, i + 1].into_iter().enumerate() {
@@ -469,26 +532,20 @@ impl RodEnergy {
                 if i == n {
                     vel[10] = velocity.theta;
                 }
-                let dofs = self.map.vertex_stencil(i);
-                for (a, d) in dofs.iter().enumerate() {
+                for (a, d) in self.map.vertex_stencil(i).iter().enumerate() {
                     if let Some(d) = d {
-                        out[*d] += (0..11).map(|b| hl[(a, b)] * vel[b]).sum::<f64>();
+                        out[*d] += (0..11).map(|b| hl[a * 11 + b] * vel[b]).sum::<f64>();
                     }
                 }
             }
         }
         if self.terms.stretching {
             let j = n - 1;
-            let q = SVector::<f64, 6>::from(edge_variables(state, j));
-            let (_, _, hl) = num_dual::hessian(
-                |v: SVector<_, 6>| stretching_energy(v.as_slice(), &self.model),
-                &q,
-            );
+            let (_, _, hl) = self.edge_local(state, j);
             let vel = [0.0, 0.0, 0.0, e.x, e.y, e.z];
-            let dofs = self.map.edge_stencil(j);
-            for (a, d) in dofs.iter().enumerate() {
+            for (a, d) in self.map.edge_stencil(j).iter().enumerate() {
                 if let Some(d) = d {
-                    out[*d] += (0..6).map(|b| hl[(a, b)] * vel[b]).sum::<f64>();
+                    out[*d] += (0..6).map(|b| hl[a * 6 + b] * vel[b]).sum::<f64>();
                 }
             }
         }

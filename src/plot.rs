@@ -1,0 +1,240 @@
+//! Bifurcation diagrams in the paper's style: the (φ/2π, Tw) plane with
+//! segments coloured green (good knot), blue (stable, knotted, not walled),
+//! brown (unknotted), red (unstable), events labelled; below, the lowest ω²
+//! and the minimum self-distance along the branches. SVG always; PNG when a
+//! TrueType font is found for the labels.
+
+use crate::branch::Event;
+use crate::equilibrium::Equilibrium;
+use anyhow::{Result, anyhow};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// The paper's colour classes.
+pub fn class_colour(e: &Equilibrium) -> RGBColor {
+    if !e.stable {
+        RGBColor(210, 40, 40) // red: unstable
+    } else if e.knot_determinant != 3 {
+        RGBColor(150, 95, 40) // brown: unknotted
+    } else if e.good_knot {
+        RGBColor(40, 160, 60) // green: good knot
+    } else {
+        RGBColor(40, 90, 200) // blue: stable, knotted, not walled (or touching)
+    }
+}
+
+/// Polylines of the branches: (branch, leg) runs, each leg after the first
+/// starting from its branch's first point.
+fn legs(eqs: &[Equilibrium]) -> Vec<Vec<&Equilibrium>> {
+    let mut out: Vec<((usize, usize), Vec<&Equilibrium>)> = Vec::new();
+    for e in eqs {
+        match out.iter_mut().find(|(k, _)| *k == (e.branch, e.leg)) {
+            Some((_, v)) => v.push(e),
+            None => {
+                let mut v = Vec::new();
+                if e.leg > 0 {
+                    if let Some(first) = eqs.iter().find(|f| f.branch == e.branch) {
+                        v.push(first);
+                    }
+                }
+                v.push(e);
+                out.push(((e.branch, e.leg), v));
+            }
+        }
+    }
+    out.into_iter().map(|(_, v)| v).collect()
+}
+
+fn font_available() -> bool {
+    use std::sync::OnceLock;
+    static OK: OnceLock<bool> = OnceLock::new();
+    *OK.get_or_init(|| {
+        let candidates = [
+            "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+            "/usr/share/fonts/TTF/DejaVuSans.ttf",
+            "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+            "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+        ];
+        for c in candidates {
+            if let Ok(bytes) = std::fs::read(c) {
+                let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+                if plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_ok() {
+                    return true;
+                }
+            }
+        }
+        false
+    })
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    eqs: &[Equilibrium],
+    events: &[Event],
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| anyhow!("{e:?}"))?;
+    let (top, bottom) = root.split_vertically((root.dim_in_pixel().1 as f64 * 0.55) as u32);
+    let (mid, low) = bottom.split_vertically(bottom.dim_in_pixel().1 / 2);
+    let finite = |v: f64| v.is_finite();
+    let xs: Vec<f64> = eqs.iter().map(|e| e.phi_over_2pi).collect();
+    let (x0, x1) = bounds(&xs);
+    let tw: Vec<f64> = eqs.iter().map(|e| e.twist).collect();
+    let (y0, y1) = bounds(&tw);
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plot: {e:?}");
+    let mut chart = ChartBuilder::on(&top)
+        .caption(title, ("sans-serif", 18))
+        .margin(8)
+        .x_label_area_size(30)
+        .y_label_area_size(50)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("φ/2π")
+        .y_desc("Tw")
+        .draw()
+        .map_err(err)?;
+    for leg in legs(eqs) {
+        for w in leg.windows(2) {
+            let colour = if w[0].stable && w[1].stable {
+                class_colour(w[1])
+            } else {
+                class_colour(if w[0].stable { w[1] } else { w[0] })
+            };
+            chart
+                .draw_series(LineSeries::new(
+                    [
+                        (w[0].phi_over_2pi, w[0].twist),
+                        (w[1].phi_over_2pi, w[1].twist),
+                    ],
+                    colour.stroke_width(3),
+                ))
+                .map_err(err)?;
+        }
+    }
+    for e in events.iter().filter(|e| !e.label.is_empty()) {
+        chart
+            .draw_series(std::iter::once(Circle::new(
+                (e.phi_over_2pi, e.twist),
+                4,
+                BLACK.filled(),
+            )))
+            .map_err(err)?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                e.label.clone(),
+                (e.phi_over_2pi, e.twist),
+                ("sans-serif", 14).into_font().color(&BLACK),
+            )))
+            .map_err(err)?;
+    }
+    // lowest ω² (signed log scale would hide the crossing: plot it linearly, clipped)
+    let om: Vec<f64> = eqs
+        .iter()
+        .filter_map(|e| e.omega_squared.first().copied())
+        .filter(|v| finite(*v))
+        .collect();
+    let (o0, o1) = bounds(&om);
+    let mut c2 = ChartBuilder::on(&mid)
+        .margin(8)
+        .x_label_area_size(25)
+        .y_label_area_size(50)
+        .build_cartesian_2d(x0..x1, o0..o1)
+        .map_err(err)?;
+    c2.configure_mesh()
+        .y_desc("lowest ω²")
+        .draw()
+        .map_err(err)?;
+    c2.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], BLACK.mix(0.4)))
+        .map_err(err)?;
+    for leg in legs(eqs) {
+        let pts: Vec<(f64, f64)> = leg
+            .iter()
+            .filter_map(|e| e.omega_squared.first().map(|w| (e.phi_over_2pi, *w)))
+            .collect();
+        c2.draw_series(LineSeries::new(pts, RGBColor(80, 80, 80).stroke_width(2)))
+            .map_err(err)?;
+    }
+    let sd: Vec<f64> = eqs
+        .iter()
+        .map(|e| e.min_self_distance)
+        .filter(|v| finite(*v))
+        .collect();
+    let (s0, s1) = bounds(&sd);
+    let mut c3 = ChartBuilder::on(&low)
+        .margin(8)
+        .x_label_area_size(30)
+        .y_label_area_size(50)
+        .build_cartesian_2d(x0..x1, s0.min(0.0)..s1)
+        .map_err(err)?;
+    c3.configure_mesh()
+        .x_desc("φ/2π")
+        .y_desc("min self-distance")
+        .draw()
+        .map_err(err)?;
+    for leg in legs(eqs) {
+        let pts: Vec<(f64, f64)> = leg
+            .iter()
+            .filter(|e| e.min_self_distance.is_finite())
+            .map(|e| (e.phi_over_2pi, e.min_self_distance))
+            .collect();
+        c3.draw_series(LineSeries::new(pts, RGBColor(40, 90, 200).stroke_width(2)))
+            .map_err(err)?;
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+fn bounds(v: &[f64]) -> (f64, f64) {
+    let lo = v
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let hi = v
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::NEG_INFINITY, f64::max);
+    if !lo.is_finite() || !hi.is_finite() {
+        return (0.0, 1.0);
+    }
+    let pad = 0.05 * (hi - lo).max(1e-9);
+    (lo - pad, hi + pad)
+}
+
+/// Write the bifurcation diagram as `stem.svg` and (fonts permitting) `stem.png`.
+/// Returns the files written.
+pub fn bifurcation_diagram(
+    stem: &Path,
+    title: &str,
+    eqs: &[Equilibrium],
+    events: &[Event],
+) -> Result<Vec<std::path::PathBuf>> {
+    let mut written = Vec::new();
+    let fonts = font_available();
+    let svg = stem.with_extension("svg");
+    draw(
+        SVGBackend::new(&svg, (900, 900)).into_drawing_area(),
+        title,
+        eqs,
+        events,
+    )?;
+    written.push(svg);
+    if fonts {
+        let png = stem.with_extension("png");
+        draw(
+            BitMapBackend::new(&png, (900, 900)).into_drawing_area(),
+            title,
+            eqs,
+            events,
+        )?;
+        written.push(png);
+    }
+    Ok(written)
+}
