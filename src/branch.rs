@@ -7,7 +7,7 @@ use crate::equilibrium::{Equilibrium, Measure, Shape, analyse};
 use crate::model::rod::{Parameter, RodState};
 use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
 use crate::solve::newton::{Newton, NewtonReport};
-use anyhow::Result;
+use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
 /// A located event.
@@ -25,7 +25,7 @@ pub struct Event {
     pub delta: f64,
     /// Twist there (the figures' vertical axis).
     pub twist: f64,
-    /// Branch it lies on.
+    /// Branch it lies on (for a loading path: the leg of the path).
     pub branch: usize,
     /// Free text (e.g. negative eigenvalue counts on either side).
     pub detail: String,
@@ -158,7 +158,10 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         let branch = self.next_branch;
         self.next_branch += 1;
         for (k, &sign) in directions.iter().enumerate() {
-            let start = self.tracer.start(state.clone(), sign)?;
+            let start = self
+                .tracer
+                .start(state.clone(), sign)
+                .context("tangent at the start")?;
             // the start point is emitted once
             self.trace(start, branch, k, k == 0)?;
         }
@@ -258,7 +261,9 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         let fold = a.tangent_p * b.tangent_p < 0.0;
         if fold {
             let s = a.tangent_p.signum();
-            let p = self.locate(a, ds, &mut |_, p| p.tangent_p.signum() == s)?;
+            let p = self
+                .locate(a, ds, &mut |_, p| p.tangent_p.signum() == s)
+                .context("locating a fold")?;
             let detail = format!(
                 "negative eigenvalues {} → {}",
                 a.negative_count, b.negative_count
@@ -267,7 +272,9 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         }
         if a.negative_count != b.negative_count {
             let na = a.negative_count;
-            let p = self.locate(a, ds, &mut |_, p| p.negative_count == na)?;
+            let p = self
+                .locate(a, ds, &mut |_, p| p.negative_count == na)
+                .context("locating a change of stability")?;
             let detail = format!("negative eigenvalues {} → {}", na, b.negative_count);
             self.events
                 .push(event("stability", &p, branch, detail.clone()));
@@ -284,7 +291,9 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         }
         if (wa.wall > 0.0) != (wb.wall > 0.0) {
             let inside = wa.wall > 0.0;
-            let p = self.locate(a, ds, &mut |_, p| (wall_of(&p.state) > 0.0) == inside)?;
+            let p = self
+                .locate(a, ds, &mut |_, p| (wall_of(&p.state) > 0.0) == inside)
+                .context("locating a wall")?;
             let detail = if inside {
                 "leaves the walls"
             } else {
@@ -294,10 +303,12 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         }
         if wa.knot != wb.knot || (wb.link - wa.link).abs() > 1.0 {
             let (ka, la) = (wa.knot, wa.link);
-            let p = self.locate(a, ds, &mut |_, p| {
-                let (knot, link) = knot_of(&p.state, &measure);
-                knot == ka && (link - la).abs() < 1.0
-            })?;
+            let p = self
+                .locate(a, ds, &mut |_, p| {
+                    let (knot, link) = knot_of(&p.state, &measure);
+                    knot == ka && (link - la).abs() < 1.0
+                })
+                .context("locating a crossing")?;
             let detail = format!(
                 "knot determinant {} → {}, link {:.3} → {:.3}",
                 wa.knot, wb.knot, wa.link, wb.link

@@ -197,7 +197,7 @@ fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()
         }
         Err(e) => Some(e),
     };
-    if scene.continuation.is_none() {
+    if scene.continuation.is_none() && scene.loading.is_empty() {
         if let Some(eq) = summary.equilibria.first() {
             print_equilibrium(eq, &scene, &mut out)?;
         }

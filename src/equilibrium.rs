@@ -94,7 +94,18 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
     let n = model.segments;
     let init = &scene.initial;
     Ok(match init.shape {
-        InitialShape::Straight => RodState::straight(n, clamps),
+        InitialShape::Straight => match init.bump {
+            None => RodState::straight(n, clamps),
+            Some(b) => {
+                let (end, phi, b) = (clamps.end_point(), clamps.phi, Vector3::from(b));
+                RodState::from_curve(
+                    n,
+                    clamps,
+                    move |s| end * s + b * (0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos())),
+                    move |s| Vector3::new((phi * s).cos(), (phi * s).sin(), 0.0),
+                )
+            }
+        },
         InitialShape::Shooting => {
             let (mut n0, mut m0) = (
                 Vector3::from(init.n0.context("initial.n0 missing")?),

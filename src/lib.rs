@@ -6,6 +6,7 @@ pub mod branch;
 pub mod cli;
 pub mod equilibrium;
 pub mod geometry;
+pub mod loading;
 pub mod model;
 pub mod plot;
 pub mod run;

@@ -33,10 +33,10 @@ fn legs(eqs: &[Equilibrium]) -> Vec<Vec<&Equilibrium>> {
             Some((_, v)) => v.push(e),
             None => {
                 let mut v = Vec::new();
-                if e.leg > 0 {
-                    if let Some(first) = eqs.iter().find(|f| f.branch == e.branch) {
-                        v.push(first);
-                    }
+                if e.leg > 0
+                    && let Some(first) = eqs.iter().find(|f| f.branch == e.branch)
+                {
+                    v.push(first);
                 }
                 v.push(e);
                 out.push(((e.branch, e.leg), v));

@@ -3,6 +3,7 @@
 
 use crate::branch::{BranchOptions, BranchRun, Event, Observer, label_events};
 use crate::equilibrium::{Measure, analyse, initial_state};
+use crate::loading::run_loading;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Parameter, RodState};
 use crate::scene::{Direction, Scene};
@@ -80,6 +81,18 @@ pub fn run_scene(
         .minimize(&mut state, &scene.solver)
         .context("Newton minimisation")?;
     let measure = Measure::of(scene);
+    if !scene.loading.is_empty() {
+        let mut events = run_loading(
+            &mut newton,
+            state,
+            &scene.loading,
+            &scene.solver,
+            &measure,
+            observer,
+        )?;
+        label_events(&mut events);
+        return Ok(events);
+    }
     let Some(spec) = &scene.continuation else {
         observer(analyse(&mut newton, &state, &report, &measure)?)?;
         return Ok(vec![]);

@@ -36,6 +36,10 @@ pub struct Scene {
     /// reached by continuation from the previous one.
     #[serde(default)]
     pub sweep: Option<SweepSpec>,
+    /// Quasi-static loading: the clamp moved in steps, each followed by energy
+    /// minimisation from the previous equilibrium (jumps detected).
+    #[serde(default)]
+    pub loading: Vec<LoadingSpec>,
     /// Knot diagnostics settings.
     #[serde(default)]
     pub diagnostics: DiagnosticsSpec,
@@ -123,6 +127,10 @@ pub struct InitialSpec {
     /// Which equilibrium of that file.
     #[serde(default)]
     pub index: usize,
+    /// Straight shape: add a clamped-clamped bump b (1 − cos 2πs)/2 to seed
+    /// buckling (b in the lab frame).
+    #[serde(default)]
+    pub bump: Option<[f64; 3]>,
 }
 
 /// Kinds of initial shape.
@@ -195,6 +203,23 @@ pub enum Direction {
     /// Both, one after the other.
     #[default]
     Both,
+}
+
+/// `[[loading]]`: one leg of a loading path.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadingSpec {
+    /// Target end displacement (unchanged if absent).
+    #[serde(default)]
+    pub z_star: Option<f64>,
+    /// Target end shift.
+    #[serde(default)]
+    pub delta: Option<f64>,
+    /// Target end rotation φ/2π (continuous).
+    #[serde(default)]
+    pub phi_over_2pi: Option<f64>,
+    /// Number of equal steps.
+    pub steps: i64,
 }
 
 /// `[sweep]`
@@ -457,6 +482,35 @@ impl Scene {
                 && m < 1
             {
                 return Err(invalid("continuation.max_points", "must be >= 1"));
+            }
+        }
+        if !self.loading.is_empty() && self.continuation.is_some() {
+            return Err(invalid(
+                "loading",
+                "a scene has either [[loading]] or [continuation], not both",
+            ));
+        }
+        for l in &self.loading {
+            if l.steps < 1 || l.steps > 1_000_000 {
+                return Err(invalid(
+                    "loading.steps",
+                    format!("must be in 1..=1000000, got {}", l.steps),
+                ));
+            }
+            for (field, v) in [
+                ("loading.z_star", l.z_star),
+                ("loading.delta", l.delta),
+                ("loading.phi_over_2pi", l.phi_over_2pi),
+            ] {
+                if let Some(v) = v {
+                    finite(field, v)?;
+                }
+            }
+            if l.z_star.is_some_and(|z| z.abs() > 1.0) {
+                return Err(invalid("loading.z_star", "|z*| must be <= 1"));
+            }
+            if l.delta.is_some_and(|d| d < 0.0) {
+                return Err(invalid("loading.delta", "must be >= 0"));
             }
         }
         if let Some(sw) = &self.sweep {

@@ -274,14 +274,23 @@ impl<'a> Tracer<'a> {
         same: &mut dyn FnMut(&mut Self, &Point) -> bool,
     ) -> Result<Point, ContinuationError> {
         let (mut lo, mut hi) = (0.0, sigma);
-        let mut last = None;
+        let mut last: Option<Point> = None;
         while (hi - lo).abs() > self.settings.locate_tolerance {
             let mid = 0.5 * (lo + hi);
-            let p = self.correct(from, mid, None)?;
+            // at a singular point itself the bordered system degenerates: try
+            // nearby abscissae before giving up on more precision
+            let mut found = None;
+            for shift in [0.0, 0.1, -0.1, 0.2, -0.2] {
+                if let Ok(p) = self.correct(from, mid + shift * (hi - lo), None) {
+                    found = Some((mid + shift * (hi - lo), p));
+                    break;
+                }
+            }
+            let Some((at, p)) = found else { break };
             if same(self, &p) {
-                lo = mid;
+                lo = at;
             } else {
-                hi = mid;
+                hi = at;
                 last = Some(p);
             }
         }

@@ -23,7 +23,7 @@ impl Default for NewtonSettings {
     fn default() -> Self {
         NewtonSettings {
             gradient_tol: 1e-10,
-            max_iterations: 200,
+            max_iterations: 1000,
             max_step: 0.05,
         }
     }

@@ -1,0 +1,180 @@
+//! Quasi-static loading: what a hand does in the lab. The clamp moves along a
+//! piecewise-linear path in (z*, δ, φ) in small steps; after each step the
+//! energy is minimised from the previous equilibrium. When that state stops
+//! being a minimum the rod jumps: the jump is detected (loss of stability of
+//! the carried state, large change of shape or of link) and recorded.
+
+use crate::branch::{Event, Observer};
+use crate::equilibrium::{Measure, analyse};
+use crate::model::rod::{Clamps, RodState};
+use crate::scene::LoadingSpec;
+use crate::solve::newton::{Newton, NewtonSettings};
+use crate::stability::lowest_eigenvalues;
+use anyhow::{Context, Result, bail};
+
+/// A step is a jump when the minimiser lands farther than this (rod lengths)
+/// from the first-order prediction (and than half the predicted move)…
+pub const JUMP_DISPLACEMENT: f64 = 0.02;
+/// …or the link changes by more than this.
+pub const JUMP_LINK: f64 = 0.5;
+
+/// Negative eigenvalue count and lowest mode of the Hessian at `state`.
+fn inertia(newton: &mut Newton, state: &RodState, want_mode: bool) -> Result<(usize, Vec<f64>)> {
+    let e = &newton.energy;
+    let mut g = vec![0.0; e.map.len()];
+    let mut v = vec![0.0; e.pattern.nnz()];
+    e.hessian(state, &mut g, &mut v);
+    let sp = lowest_eigenvalues(
+        &e.pattern,
+        &v,
+        None,
+        usize::from(want_mode),
+        &mut newton.ldlt,
+    )?;
+    Ok((
+        sp.negative_count,
+        sp.vectors.into_iter().next().unwrap_or_default(),
+    ))
+}
+
+/// Minimise from `state` and make sure the result is a minimum: from a saddle,
+/// step off along the unstable mode (both ways tried, the lower energy kept).
+pub fn settle(
+    newton: &mut Newton,
+    state: &mut RodState,
+    settings: &NewtonSettings,
+) -> Result<crate::solve::newton::NewtonReport> {
+    let mut report = newton.minimize(state, settings)?;
+    for _ in 0..8 {
+        let (neg, mode) = inertia(newton, state, true)?;
+        if neg == 0 {
+            return Ok(report);
+        }
+        let map = newton.energy.map;
+        let largest = (0..mode.len())
+            .filter(|&d| map.is_translation(d))
+            .map(|d| mode[d].abs())
+            .fold(0.0, f64::max);
+        if largest == 0.0 {
+            bail!("saddle with no translational unstable mode");
+        }
+        let mut best: Option<(f64, RodState, crate::solve::newton::NewtonReport)> = None;
+        for sign in [1.0, -1.0] {
+            let kick: Vec<f64> = mode.iter().map(|x| sign * 1e-3 * x / largest).collect();
+            let mut trial = state.displaced(&map, &kick);
+            let r = newton.minimize(&mut trial, settings)?;
+            if best.as_ref().is_none_or(|b| r.energy < b.0) {
+                best = Some((r.energy, trial, r));
+            }
+        }
+        let (_, s, r) = best.unwrap();
+        *state = s;
+        report = r;
+    }
+    bail!("could not reach a stable equilibrium from a saddle")
+}
+
+/// Largest node distance between two states.
+fn max_move(a: &RodState, b: &RodState) -> f64 {
+    a.nodes
+        .iter()
+        .zip(&b.nodes)
+        .map(|(x, y)| (x - y).norm())
+        .fold(0.0, f64::max)
+}
+
+fn eq_clamps(eq: &crate::equilibrium::Equilibrium) -> Clamps {
+    eq.state.clamps
+}
+
+/// The equilibrium `state` moved to clamps `c` along its tangent (first order
+/// in the clamp move); just the moved clamp if the Hessian is not definite.
+fn predict(newton: &mut Newton, state: &RodState, c: Clamps) -> Result<RodState> {
+    let e = &newton.energy;
+    let n = e.map.len();
+    let mut g = vec![0.0; n];
+    let mut v = vec![0.0; e.pattern.nnz()];
+    e.hessian(state, &mut g, &mut v);
+    let velocity = crate::model::energy::ClampVelocity {
+        end: c.end_point() - state.clamps.end_point(),
+        theta: c.phi - state.clamps.phi,
+    };
+    let mut dq = vec![0.0; n];
+    e.gradient_parameter_derivative(state, &velocity, &mut dq);
+    let mut moved = state.clone();
+    moved.set_clamps(c);
+    if newton.ldlt.factor(&v).is_ok() && newton.ldlt.negative_count() == 0 {
+        newton.ldlt.solve_in_place(&mut dq);
+        dq.iter_mut().for_each(|x| *x = -*x);
+        let map = newton.energy.map;
+        Ok(moved.displaced(&map, &dq))
+    } else {
+        Ok(moved)
+    }
+}
+
+/// Run the loading path from `state` (an equilibrium at its clamps): every
+/// equilibrium goes to `observer`; returns the jumps.
+pub fn run_loading(
+    newton: &mut Newton,
+    mut state: RodState,
+    path: &[LoadingSpec],
+    settings: &NewtonSettings,
+    measure: &Measure,
+    observer: &mut Observer<'_>,
+) -> Result<Vec<Event>> {
+    let mut events = Vec::new();
+    let report = settle(newton, &mut state, settings)?;
+    let mut eq = analyse(newton, &state, &report, measure)?;
+    observer(eq.clone())?;
+    for (leg, stage) in path.iter().enumerate() {
+        let c0 = state.clamps;
+        let target = Clamps {
+            z_star: stage.z_star.unwrap_or(c0.z_star),
+            delta: stage.delta.unwrap_or(c0.delta),
+            phi: stage
+                .phi_over_2pi
+                .map_or(c0.phi, |p| 2.0 * std::f64::consts::PI * p),
+        };
+        let steps = stage.steps as usize;
+        for k in 1..=steps {
+            let f = k as f64 / steps as f64;
+            let c = Clamps {
+                z_star: c0.z_star + f * (target.z_star - c0.z_star),
+                delta: c0.delta + f * (target.delta - c0.delta),
+                phi: c0.phi + f * (target.phi - c0.phi),
+            };
+            // first-order prediction along the branch: dq = −H⁻¹ ∂_p∇E
+            let predicted = predict(newton, &state, c)?;
+            let predicted_move = max_move(&predicted, &state);
+            state = predicted.clone();
+            let report = settle(newton, &mut state, settings)
+                .with_context(|| format!("loading leg {leg}, step {k}"))?;
+            let next = analyse(newton, &state, &report, measure)?;
+            // a smooth branch lands within second order of the prediction; a
+            // jump lands far away, or changes the link by a crossing
+            let miss = max_move(&state, &predicted);
+            let dlink =
+                next.link - eq.link - (c.phi - eq_clamps(&eq).phi) / (2.0 * std::f64::consts::PI);
+            if miss > (0.5 * predicted_move).max(JUMP_DISPLACEMENT) || dlink.abs() > JUMP_LINK {
+                events.push(Event {
+                    kind: "jump".into(),
+                    label: String::new(),
+                    phi_over_2pi: c.phi_over_2pi(),
+                    z_star: c.z_star,
+                    delta: c.delta,
+                    twist: eq.twist,
+                    // for a loading path, the leg of the path
+                    branch: leg,
+                    detail: format!(
+                        "lands {miss:.4} from the prediction, link {:.3} → {:.3}, twist {:.3} → {:.3}",
+                        eq.link, next.link, eq.twist, next.twist
+                    ),
+                });
+            }
+            observer(next.clone())?;
+            eq = next;
+        }
+    }
+    Ok(events)
+}

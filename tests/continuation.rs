@@ -1,0 +1,221 @@
+//! Continuation and quasi-static loading: folds, jumps, hysteresis, and the
+//! paper's Figure 3 branch.
+
+use knotrod::branch::{BranchOptions, BranchRun, Event};
+use knotrod::equilibrium::{Equilibrium, Measure};
+use knotrod::model::energy::RodEnergy;
+use knotrod::model::rod::{Parameter, RodState};
+use knotrod::run::run_scene;
+use knotrod::scene::Scene;
+use knotrod::solve::continuation::ContinuationSettings;
+use knotrod::solve::newton::Newton;
+
+fn run(scene: &Scene) -> (Vec<Equilibrium>, Vec<Event>) {
+    let mut eqs = Vec::new();
+    let events = run_scene(scene, None, &mut |e| {
+        eqs.push(e);
+        Ok(())
+    })
+    .unwrap();
+    (eqs, events)
+}
+
+/// A paper scene at another N with extra TOML appended.
+fn paper_scene(file: &str, segments: usize, extra: &str) -> Scene {
+    let text = std::fs::read_to_string(file).unwrap();
+    let text = text.replace("segments = 200", &format!("segments = {segments}"));
+    let text = text.split("[output]").next().unwrap().to_string();
+    let text = text.split("[continuation]").next().unwrap().to_string();
+    let mut scene = Scene::parse(&format!("{text}\n{extra}")).unwrap();
+    scene.name = Some(file.into());
+    scene
+}
+
+#[test]
+fn rotating_the_clamp_down_past_s_jumps_and_does_not_come_back() {
+    // the Appendix D knot, clamp rotated down past the subcritical pitchfork S
+    // (φ/2π ≈ 0.751) and back up: one jump, and hysteresis
+    let scene = paper_scene(
+        "scenes/appendix_d.toml",
+        100,
+        "[[loading]]\nphi_over_2pi = 0.70\nsteps = 51\n[[loading]]\nphi_over_2pi = 0.802\nsteps = 50\n",
+    );
+    let (eqs, events) = run(&scene);
+    assert_eq!(eqs.len(), 102);
+    for e in &eqs {
+        assert!(
+            e.converged && e.negative_eigenvalues == 0,
+            "not a converged minimum at φ/2π = {}",
+            e.phi_over_2pi
+        );
+    }
+    let jumps: Vec<&Event> = events.iter().filter(|e| e.kind == "jump").collect();
+    assert_eq!(jumps.len(), 1, "{events:?}");
+    assert_eq!(jumps[0].branch, 0, "the jump happens on the way down");
+    assert!(
+        (jumps[0].phi_over_2pi - 0.751).abs() < 0.005,
+        "jump at {}",
+        jumps[0].phi_over_2pi
+    );
+    // hysteresis: back at φ/2π = 0.80 the rod is not the knot it started as
+    let (first, last) = (&eqs[0], eqs.last().unwrap());
+    assert!((first.phi_over_2pi - last.phi_over_2pi).abs() < 1e-12);
+    assert!(
+        (first.link - last.link).abs() > 1.0,
+        "link {} vs {}",
+        first.link,
+        last.link
+    );
+}
+
+/// Continue the Appendix E knot (N = 100) down in φ: it meets a fold.
+fn appendix_e_fold(step: f64) -> (Vec<Equilibrium>, Vec<Event>) {
+    let scene = paper_scene(
+        "scenes/appendix_e.toml",
+        100,
+        &format!(
+            "[continuation]\nparameter = \"phi\"\nrange = [0.70, 0.80]\ndirection = \"down\"\nstep = {step}\nmax_points = 40\n"
+        ),
+    );
+    run(&scene)
+}
+
+#[test]
+fn continuation_locates_a_fold_and_continues_on_the_unstable_side() {
+    let (points, events) = appendix_e_fold(0.005);
+    let fold = events.iter().find(|e| e.kind == "fold").expect("a fold");
+    assert!(fold.detail.contains("0 → 1"), "{fold:?}");
+    // the fold is the extreme φ of the branch
+    let min_phi = points
+        .iter()
+        .map(|p| p.phi_over_2pi)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        fold.phi_over_2pi <= min_phi + 1e-9,
+        "fold {} above a branch point at {min_phi}",
+        fold.phi_over_2pi
+    );
+    // beyond it the branch has exactly one negative eigenvalue
+    let k = points
+        .iter()
+        .position(|p| p.negative_eigenvalues > 0)
+        .expect("unstable side reached");
+    assert!(
+        points[k..]
+            .iter()
+            .take(5)
+            .all(|p| p.negative_eigenvalues == 1)
+    );
+    assert!(points[..k].iter().all(|p| p.negative_eigenvalues == 0));
+    // located to 1e-6 in the parameter: independent of the step sequence
+    let (_, again) = appendix_e_fold(0.0031);
+    let fold2 = again
+        .iter()
+        .find(|e| e.kind == "fold")
+        .expect("fold found again");
+    assert!(
+        (fold.phi_over_2pi - fold2.phi_over_2pi).abs() < 1e-6,
+        "{} vs {}",
+        fold.phi_over_2pi,
+        fold2.phi_over_2pi
+    );
+}
+
+#[test]
+fn figure_3_events_at_n_200() {
+    let scene = paper_scene(
+        "scenes/appendix_d.toml",
+        200,
+        "[continuation]\nparameter = \"phi\"\nrange = [0.745, 0.99]\ndirection = \"both\"\n",
+    );
+    let (_, events) = run(&scene);
+    let find = |kind: &str, near: f64| {
+        events
+            .iter()
+            .filter(|e| e.kind == kind && e.branch == 0)
+            .map(|e| e.phi_over_2pi)
+            .min_by(|a, b| (a - near).abs().total_cmp(&(b - near).abs()))
+            .unwrap_or_else(|| panic!("no {kind} event: {events:?}"))
+    };
+    let (w1, w2, x, s) = (
+        find("wall", 0.774),
+        find("wall", 0.82),
+        find("crossing", 0.96),
+        find("branch_point", 0.75),
+    );
+    assert!((w1 - 0.774).abs() < 0.005, "W1 at {w1}");
+    assert!((w2 - 0.82).abs() < 0.01, "W2 at {w2}");
+    assert!((x - 0.96).abs() < 0.01, "X at {x}");
+    assert!(s < w1 && s > 0.745, "S at {s}");
+    let bp = events.iter().find(|e| e.kind == "branch_point").unwrap();
+    assert!(
+        bp.detail.starts_with("negative eigenvalues 0 → 1"),
+        "{bp:?}"
+    );
+}
+
+#[test]
+fn two_mirror_branches_leave_the_pitchfork() {
+    let scene = paper_scene(
+        "scenes/appendix_d.toml",
+        60,
+        "[continuation]\nparameter = \"phi\"\nrange = [0.70, 0.81]\ndirection = \"down\"\nswitch_branches = true\nmax_points = 60\n",
+    );
+    let (eqs, events) = run(&scene);
+    assert!(
+        events.iter().any(|e| e.kind == "branch_point"),
+        "{events:?}"
+    );
+    let branch = |b: usize| -> Vec<&Equilibrium> { eqs.iter().filter(|e| e.branch == b).collect() };
+    let (b1, b2) = (branch(1), branch(2));
+    assert!(
+        b1.len() > 3 && b2.len() > 3,
+        "bifurcating branches not followed"
+    );
+    // not flip-symmetric, unstable, and the two share their (φ, Tw) projection
+    // (mirror images of each other under the flip)
+    // (the lowest eigenvalue leaves 0 slowly: check stability farther out)
+    for p in b1.iter().chain(&b2).skip(8).take(4) {
+        assert!(
+            p.negative_eigenvalues > 0,
+            "stable point on a bifurcating branch at φ/2π = {}",
+            p.phi_over_2pi
+        );
+    }
+    assert!(b1.len() > 12 && b2.len() > 12);
+    // every point of one lies on the other's polyline in the (φ/2π, Tw) plane
+    let on_b1 = |q: &Equilibrium| {
+        b1.windows(2)
+            .map(|w| {
+                let (a, b) = (
+                    (w[0].phi_over_2pi, w[0].twist),
+                    (w[1].phi_over_2pi, w[1].twist),
+                );
+                let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+                let t = (((q.phi_over_2pi - a.0) * dx + (q.twist - a.1) * dy)
+                    / (dx * dx + dy * dy))
+                    .clamp(0.0, 1.0);
+                ((q.phi_over_2pi - a.0 - t * dx).powi(2) + (q.twist - a.1 - t * dy).powi(2)).sqrt()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    for q in b2.iter().take(12) {
+        assert!(
+            on_b1(q) < 1e-4,
+            "({}, {}) off the mirror branch by {}",
+            q.phi_over_2pi,
+            q.twist,
+            on_b1(q)
+        );
+    }
+    for (p, q) in b1.iter().zip(&b2).take(12) {
+        let d: f64 = p
+            .state
+            .nodes
+            .iter()
+            .zip(&q.state.nodes)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        assert!(d > 1e-3, "the two branches coincide");
+    }
+}
