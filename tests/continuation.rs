@@ -1,14 +1,10 @@
 //! Continuation and quasi-static loading: folds, jumps, hysteresis, and the
 //! paper's Figure 3 branch.
 
-use knotrod::branch::{BranchOptions, BranchRun, Event};
-use knotrod::equilibrium::{Equilibrium, Measure};
-use knotrod::model::energy::RodEnergy;
-use knotrod::model::rod::{Parameter, RodState};
+use knotrod::branch::Event;
+use knotrod::equilibrium::Equilibrium;
 use knotrod::run::run_scene;
 use knotrod::scene::Scene;
-use knotrod::solve::continuation::ContinuationSettings;
-use knotrod::solve::newton::Newton;
 
 fn run(scene: &Scene) -> (Vec<Equilibrium>, Vec<Event>) {
     let mut eqs = Vec::new();
