@@ -4,7 +4,7 @@ use crate::geometry::closure::{extent, ray_closure};
 use crate::geometry::knot::knot_type;
 use crate::geometry::polyline::read_points;
 use crate::geometry::writhe::writhe_closed;
-use crate::plot::bifurcation_diagram;
+use crate::plot::{PlotPoint, bifurcation_diagram};
 use crate::run::run_scene;
 use crate::scene::Scene;
 use crate::summary::{Summary, print_equilibrium, print_events};
@@ -37,6 +37,31 @@ pub enum Command {
         /// Override the scene's number of segments.
         #[arg(long)]
         segments: Option<usize>,
+        /// Record to this MCAP file (default: recordings/<scene>.mcap).
+        #[arg(long)]
+        record: Option<PathBuf>,
+        /// Do not record.
+        #[arg(long, conflicts_with = "record")]
+        no_record: bool,
+    },
+    /// Channels, states, parameter range and events of a recording.
+    Info {
+        /// The MCAP recording.
+        recording: PathBuf,
+    },
+    /// One recorded state as a table (csv, json) or a tube mesh (obj).
+    Export {
+        /// The MCAP recording.
+        recording: PathBuf,
+        /// Index of the state.
+        #[arg(long, default_value_t = 0)]
+        index: u64,
+        /// csv | json | obj.
+        #[arg(long, value_enum, default_value = "csv")]
+        format: ExportFormat,
+        /// Output file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Writhe and knot type of any curve (one "x y z" or "x,y,z" point per line).
     Knot {
@@ -53,9 +78,9 @@ pub enum Command {
         #[arg(long)]
         json: Option<PathBuf>,
     },
-    /// Redraw the bifurcation diagram of a run's JSON summary.
+    /// Redraw the bifurcation diagram of a run's JSON summary or MCAP recording.
     Plot {
-        /// The summary (written by `run --json`).
+        /// The summary (`run --json`) or recording (`.mcap`).
         summary: PathBuf,
         /// Output stem (default: the summary's path without extension).
         #[arg(long)]
@@ -77,6 +102,17 @@ pub enum Command {
     },
 }
 
+/// Export formats.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum ExportFormat {
+    /// Nodes and material frames, one row per node.
+    Csv,
+    /// The full state.
+    Json,
+    /// A triangle mesh of the tube.
+    Obj,
+}
+
 /// Directions of the closing rays of an open curve.
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
 pub enum RayKind {
@@ -93,7 +129,23 @@ pub fn main_with(cli: Cli) -> Result<()> {
             scene,
             json,
             segments,
-        } => run(&scene, json, segments),
+            record,
+            no_record,
+        } => run(
+            &scene,
+            json,
+            segments,
+            if no_record { None } else { Some(record) },
+        ),
+        Command::Info { recording } => {
+            crate::export::info(&recording, &mut std::io::stdout().lock())
+        }
+        Command::Export {
+            recording,
+            index,
+            format,
+            out,
+        } => crate::export::export(&recording, index, format, out.as_deref()),
         Command::Convergence { scene, segments } => convergence(&scene, &segments),
         Command::Knot {
             curve,
@@ -102,13 +154,29 @@ pub fn main_with(cli: Cli) -> Result<()> {
             json,
         } => knot(&curve, closed, rays, json),
         Command::Plot { summary, out } => {
-            let text = std::fs::read_to_string(&summary)
-                .with_context(|| format!("cannot read {}", summary.display()))?;
-            let s: Summary = serde_json::from_str(&text)
-                .with_context(|| format!("{} is not a knotrod summary", summary.display()))?;
             let stem = out.unwrap_or_else(|| summary.with_extension(""));
-            let title = format!("{} (N = {})", s.scene, s.segments);
-            for f in bifurcation_diagram(&stem, &title, &s.equilibria, &s.events)? {
+            let (title, points, events) = if summary.extension().is_some_and(|e| e == "mcap") {
+                let rec = crate::record::read_recording(&summary)?;
+                let points: Vec<PlotPoint> = rec.scalars.iter().map(PlotPoint::from).collect();
+                let title = summary
+                    .file_stem()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .into_owned();
+                (title, points, rec.events)
+            } else {
+                let text = std::fs::read_to_string(&summary)
+                    .with_context(|| format!("cannot read {}", summary.display()))?;
+                let s: Summary = serde_json::from_str(&text)
+                    .with_context(|| format!("{} is not a knotrod summary", summary.display()))?;
+                let points = s.equilibria.iter().map(PlotPoint::from).collect();
+                (
+                    format!("{} (N = {})", s.scene, s.segments),
+                    points,
+                    s.events,
+                )
+            };
+            for f in bifurcation_diagram(&stem, &title, &points, &events)? {
                 writeln!(std::io::stdout().lock(), "plot written to {}", f.display())?;
             }
             Ok(())
@@ -120,8 +188,18 @@ pub fn main_with(cli: Cli) -> Result<()> {
     }
 }
 
-fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()> {
+/// Set by Ctrl-C / SIGTERM: the run stops at the next equilibrium and still
+/// finalises its recording and summary.
+static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+fn run(
+    path: &Path,
+    json: Option<PathBuf>,
+    segments: Option<usize>,
+    record: Option<Option<PathBuf>>,
+) -> Result<()> {
     let scene = Scene::load(path)?;
+    let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst));
     if let Some(n) = segments {
         anyhow::ensure!(
             (4..=1_000_000).contains(&n),
@@ -149,6 +227,22 @@ fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()
         }
         None => None,
     };
+    let mut recorder = match record {
+        Some(file) => {
+            let file = file.unwrap_or_else(|| {
+                PathBuf::from("recordings")
+                    .join(format!("{}.mcap", scene.name.as_deref().unwrap_or("run")))
+            });
+            let text = std::fs::read_to_string(path).unwrap_or_default();
+            Some(crate::record::Recorder::create(
+                &file,
+                &text,
+                &model,
+                scene.model.rod_diameter,
+            )?)
+        }
+        None => None,
+    };
     let progress = indicatif::ProgressBar::new_spinner();
     progress.set_style(
         indicatif::ProgressStyle::with_template("{spinner} {elapsed} {pos} equilibria — {msg}")
@@ -162,6 +256,9 @@ fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()
                 w.write_all(b"\n")?;
                 w.flush()?;
             }
+            if let Some(r) = recorder.as_mut() {
+                r.record(&eq)?;
+            }
             progress.inc(1);
             progress.set_message(format!(
                 "branch {}: z* = {:.4}, δ = {:.4}, φ/2π = {:.4}, Tw = {:.4}{}",
@@ -173,6 +270,9 @@ fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()
                 if eq.stable { "" } else { " (unstable)" }
             ));
             equilibria.push(eq);
+            if INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
+                anyhow::bail!("interrupted (Ctrl-C): stopped after this equilibrium");
+            }
             Ok(())
         };
         run_scene(&scene, segments, &mut observer)
@@ -197,6 +297,17 @@ fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()
         }
         Err(e) => Some(e),
     };
+    // the recording is finalised whatever happened, with what was computed
+    if let Some(mut r) = recorder {
+        r.events(&summary.events)?;
+        let (file, states) = (r.path().to_path_buf(), r.len());
+        r.finish()?;
+        writeln!(
+            out,
+            "recording written to {} ({states} states)",
+            file.display()
+        )?;
+    }
     if scene.continuation.is_none() && scene.loading.is_empty() {
         if let Some(eq) = summary.equilibria.first() {
             print_equilibrium(eq, &scene, &mut out)?;
@@ -210,7 +321,8 @@ fn run(path: &Path, json: Option<PathBuf>, segments: Option<usize>) -> Result<()
             std::fs::create_dir_all(dir)?;
         }
         let title = format!("{} (N = {})", summary.scene, summary.segments);
-        for f in bifurcation_diagram(&stem, &title, &summary.equilibria, &summary.events)? {
+        let points: Vec<PlotPoint> = summary.equilibria.iter().map(PlotPoint::from).collect();
+        for f in bifurcation_diagram(&stem, &title, &points, &summary.events)? {
             writeln!(out, "plot written to {}", f.display())?;
         }
     }

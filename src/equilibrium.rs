@@ -93,6 +93,19 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
     let clamps = scene.clamps();
     let n = model.segments;
     let init = &scene.initial;
+    if let Some(path) = &init.from_recording {
+        let msg =
+            crate::record::read_state(path, init.index as u64).context("initial.from_recording")?;
+        let mut state = msg.state;
+        if state.segments() != n {
+            bail!(
+                "initial.from_recording: state has {} segments, model.segments is {n}",
+                state.segments()
+            );
+        }
+        state.set_clamps(clamps);
+        return Ok(state);
+    }
     Ok(match init.shape {
         InitialShape::Straight => match init.bump {
             None => RodState::straight(n, clamps),

@@ -13,21 +13,76 @@ use std::path::Path;
 
 /// The paper's colour classes.
 pub fn class_colour(e: &Equilibrium) -> RGBColor {
-    if !e.stable {
+    colour_of(e.stable, e.knot_determinant, e.good_knot)
+}
+
+fn colour_of(stable: bool, knot_determinant: u64, good_knot: bool) -> RGBColor {
+    if !stable {
         RGBColor(210, 40, 40) // red: unstable
-    } else if e.knot_determinant != 3 {
+    } else if knot_determinant != 3 {
         RGBColor(150, 95, 40) // brown: unknotted
-    } else if e.good_knot {
+    } else if good_knot {
         RGBColor(40, 160, 60) // green: good knot
     } else {
         RGBColor(40, 90, 200) // blue: stable, knotted, not walled (or touching)
     }
 }
 
+/// What a bifurcation diagram needs of one equilibrium.
+#[derive(Clone, Debug)]
+pub struct PlotPoint {
+    /// φ/2π.
+    pub phi_over_2pi: f64,
+    /// Tw.
+    pub twist: f64,
+    /// Stable.
+    pub stable: bool,
+    /// Class colour.
+    pub colour: RGBColor,
+    /// Lowest ω².
+    pub omega_squared: Option<f64>,
+    /// Minimum self-distance.
+    pub min_self_distance: f64,
+    /// Branch.
+    pub branch: usize,
+    /// Leg.
+    pub leg: usize,
+}
+
+impl From<&Equilibrium> for PlotPoint {
+    fn from(e: &Equilibrium) -> Self {
+        PlotPoint {
+            phi_over_2pi: e.phi_over_2pi,
+            twist: e.twist,
+            stable: e.stable,
+            colour: class_colour(e),
+            omega_squared: e.omega_squared.first().copied(),
+            min_self_distance: e.min_self_distance,
+            branch: e.branch,
+            leg: e.leg,
+        }
+    }
+}
+
+impl From<&crate::record::Scalars> for PlotPoint {
+    fn from(e: &crate::record::Scalars) -> Self {
+        PlotPoint {
+            phi_over_2pi: e.phi_over_2pi,
+            twist: e.twist,
+            stable: e.stable,
+            colour: colour_of(e.stable, e.knot_determinant, e.good_knot),
+            omega_squared: Some(e.lowest_omega_squared).filter(|v| v.is_finite()),
+            min_self_distance: e.min_self_distance,
+            branch: e.branch,
+            leg: e.leg,
+        }
+    }
+}
+
 /// Polylines of the branches: (branch, leg) runs, each leg after the first
 /// starting from its branch's first point.
-fn legs(eqs: &[Equilibrium]) -> Vec<Vec<&Equilibrium>> {
-    let mut out: Vec<((usize, usize), Vec<&Equilibrium>)> = Vec::new();
+fn legs(eqs: &[PlotPoint]) -> Vec<Vec<&PlotPoint>> {
+    let mut out: Vec<((usize, usize), Vec<&PlotPoint>)> = Vec::new();
     for e in eqs {
         match out.iter_mut().find(|(k, _)| *k == (e.branch, e.leg)) {
             Some((_, v)) => v.push(e),
@@ -71,7 +126,7 @@ fn font_available() -> bool {
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
-    eqs: &[Equilibrium],
+    eqs: &[PlotPoint],
     events: &[Event],
 ) -> Result<()>
 where
@@ -101,10 +156,11 @@ where
         .map_err(err)?;
     for leg in legs(eqs) {
         for w in leg.windows(2) {
-            let colour = if w[0].stable && w[1].stable {
-                class_colour(w[1])
+            // a segment takes the class of its unstable end, if any
+            let colour = if w[0].stable {
+                w[1].colour
             } else {
-                class_colour(if w[0].stable { w[1] } else { w[0] })
+                w[0].colour
             };
             chart
                 .draw_series(LineSeries::new(
@@ -136,7 +192,7 @@ where
     // lowest ω² (signed log scale would hide the crossing: plot it linearly, clipped)
     let om: Vec<f64> = eqs
         .iter()
-        .filter_map(|e| e.omega_squared.first().copied())
+        .filter_map(|e| e.omega_squared)
         .filter(|v| finite(*v))
         .collect();
     let (o0, o1) = bounds(&om);
@@ -155,7 +211,7 @@ where
     for leg in legs(eqs) {
         let pts: Vec<(f64, f64)> = leg
             .iter()
-            .filter_map(|e| e.omega_squared.first().map(|w| (e.phi_over_2pi, *w)))
+            .filter_map(|e| e.omega_squared.map(|w| (e.phi_over_2pi, w)))
             .collect();
         c2.draw_series(LineSeries::new(pts, RGBColor(80, 80, 80).stroke_width(2)))
             .map_err(err)?;
@@ -213,7 +269,7 @@ fn bounds(v: &[f64]) -> (f64, f64) {
 pub fn bifurcation_diagram(
     stem: &Path,
     title: &str,
-    eqs: &[Equilibrium],
+    eqs: &[PlotPoint],
     events: &[Event],
 ) -> Result<Vec<std::path::PathBuf>> {
     let mut written = Vec::new();

@@ -127,6 +127,10 @@ pub struct InitialSpec {
     /// Which equilibrium of that file.
     #[serde(default)]
     pub index: usize,
+    /// Start from a recorded state (MCAP written by `knotrod run`), `index`
+    /// selecting which (its model's N must match `model.segments`).
+    #[serde(default)]
+    pub from_recording: Option<PathBuf>,
     /// Straight shape: add a clamped-clamped bump b (1 − cos 2πs)/2 to seed
     /// buckling (b in the lab frame).
     #[serde(default)]

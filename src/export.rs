@@ -1,0 +1,109 @@
+//! Reading recordings back: `knotrod info` and `knotrod export`.
+
+use crate::cli::ExportFormat;
+use crate::record::{read_recording, read_state};
+use anyhow::{Context, Result};
+use std::io::Write;
+use std::path::Path;
+
+/// Print what a recording holds.
+pub fn info(path: &Path, out: &mut impl Write) -> Result<()> {
+    let rec = read_recording(path)?;
+    writeln!(out, "recording {}", path.display())?;
+    if let Some(v) = rec.metadata.get("knotrod_version") {
+        writeln!(
+            out,
+            "  written by knotrod {v} (git {})",
+            rec.metadata.get("git_revision").map_or("?", |s| s.as_str())
+        )?;
+    }
+    writeln!(out, "  channels:")?;
+    for (topic, count) in &rec.channels {
+        writeln!(out, "    {topic:<14} {count} messages")?;
+    }
+    writeln!(out, "  states: {}", rec.scalars.len())?;
+    let range = |f: fn(&crate::record::Scalars) -> f64| {
+        let v: Vec<f64> = rec.scalars.iter().map(f).collect();
+        (
+            v.iter().copied().fold(f64::INFINITY, f64::min),
+            v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        )
+    };
+    if !rec.scalars.is_empty() {
+        for (name, (lo, hi)) in [
+            ("z*", range(|s| s.z_star)),
+            ("δ", range(|s| s.delta)),
+            ("φ/2π", range(|s| s.phi_over_2pi)),
+            ("Tw", range(|s| s.twist)),
+        ] {
+            writeln!(out, "  {name:<5} from {lo:.5} to {hi:.5}")?;
+        }
+        let stable = rec.scalars.iter().filter(|s| s.stable).count();
+        let good = rec.scalars.iter().filter(|s| s.good_knot).count();
+        writeln!(out, "  {stable} stable states, {good} good knots")?;
+    }
+    writeln!(out, "  events: {}", rec.events.len())?;
+    for e in &rec.events {
+        writeln!(
+            out,
+            "    {:<5} {:<13} branch {} z* {:.5} φ/2π {:.5}  {}",
+            e.label, e.kind, e.branch, e.z_star, e.phi_over_2pi, e.detail
+        )?;
+    }
+    Ok(())
+}
+
+/// Export one recorded state.
+pub fn export(path: &Path, index: u64, format: ExportFormat, out: Option<&Path>) -> Result<()> {
+    let msg = read_state(path, index)?;
+    let s = &msg.state;
+    let mut text = String::new();
+    use std::fmt::Write as _;
+    match format {
+        ExportFormat::Json => text = serde_json::to_string_pretty(&msg)?,
+        ExportFormat::Csv => {
+            writeln!(text, "node,s,x,y,z,d1x,d1y,d1z,d2x,d2y,d2z")?;
+            let (points, arc) = s.centreline();
+            let n = s.segments();
+            for (k, (p, a)) in points.iter().zip(&arc).enumerate() {
+                // the frame of the edge starting at this point (clamp frame at the ends)
+                let j = k.min(n);
+                let [d1, d2, _] = s.directors(j);
+                writeln!(
+                    text,
+                    "{k},{a},{},{},{},{},{},{},{},{},{}",
+                    p.x, p.y, p.z, d1.x, d1.y, d1.z, d2.x, d2.y, d2.z
+                )?;
+            }
+        }
+        ExportFormat::Obj => {
+            // a tube around the centreline, 12 sides, of the diameter of the
+            // solid circular rod with this stretching stiffness (S = 16/h²)
+            let radius = 2.0 / msg.model.stretching_stiffness.sqrt();
+            let (points, _) = s.centreline();
+            let sides = 12;
+            writeln!(text, "# knotrod state {index} of {}", path.display())?;
+            let n = s.segments();
+            for (k, p) in points.iter().enumerate() {
+                let [d1, d2, _] = s.directors(k.min(n));
+                for q in 0..sides {
+                    let a = 2.0 * std::f64::consts::PI * q as f64 / sides as f64;
+                    let v = p + radius * (a.cos() * d1 + a.sin() * d2);
+                    writeln!(text, "v {} {} {}", v.x, v.y, v.z)?;
+                }
+            }
+            for k in 0..points.len() - 1 {
+                for q in 0..sides {
+                    let (a, b) = (k * sides + q + 1, k * sides + (q + 1) % sides + 1);
+                    let (c, d) = (a + sides, b + sides);
+                    writeln!(text, "f {a} {b} {d} {c}")?;
+                }
+            }
+        }
+    }
+    match out {
+        Some(p) => std::fs::write(p, text).with_context(|| format!("writing {}", p.display()))?,
+        None => std::io::stdout().lock().write_all(text.as_bytes())?,
+    }
+    Ok(())
+}

@@ -1,0 +1,299 @@
+//! Recordings: MCAP written by every run, readable by the mcap crate with
+//! Foxglove's exact schemas, restartable, finalised on Ctrl-C, and read back
+//! with clear errors when damaged.
+
+use knotrod::record::{
+    SCALARS_TOPIC, SCENE_TOPIC, STATE_TOPIC, TF_TOPIC, read_recording, read_state,
+};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn knotrod(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_knotrod"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("knotrod-rec-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A short branch of the Figure 3 problem at N = 40.
+fn short_branch_scene(dir: &Path, extra: &str) -> PathBuf {
+    let text = std::fs::read_to_string("scenes/appendix_d.toml")
+        .unwrap()
+        .replace("segments = 200", "segments = 40");
+    let text = text.split("[reference]").next().unwrap().to_string();
+    let scene = dir.join("branch.toml");
+    std::fs::write(
+        &scene,
+        format!("{text}\n[continuation]\nparameter = \"phi\"\nrange = [0.78, 0.84]\ndirection = \"up\"\n{extra}"),
+    )
+    .unwrap();
+    scene
+}
+
+#[test]
+fn recording_has_foxglove_schemas_and_every_message_decodes() {
+    let dir = temp("schemas");
+    let scene = short_branch_scene(&dir, "");
+    let rec = dir.join("run.mcap");
+    let out = knotrod(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--record",
+        rec.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(&rec).unwrap();
+    let summary = mcap::Summary::read(&bytes)
+        .unwrap()
+        .expect("finalised with a summary");
+    let mut schemas: Vec<(String, String, String)> = summary
+        .channels
+        .values()
+        .map(|c| {
+            let s = c.schema.as_ref().unwrap();
+            (c.topic.clone(), s.name.clone(), s.encoding.clone())
+        })
+        .collect();
+    schemas.sort();
+    assert!(schemas.contains(&(
+        SCENE_TOPIC.into(),
+        "foxglove.SceneUpdate".into(),
+        "protobuf".into()
+    )));
+    assert!(schemas.contains(&(
+        TF_TOPIC.into(),
+        "foxglove.FrameTransform".into(),
+        "protobuf".into()
+    )));
+    assert!(schemas.contains(&(
+        SCALARS_TOPIC.into(),
+        "knotrod.Scalars".into(),
+        "jsonschema".into()
+    )));
+    let mut counts = std::collections::BTreeMap::<String, usize>::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        *counts.entry(m.channel.topic.clone()).or_default() += 1;
+        match m.channel.topic.as_str() {
+            SCENE_TOPIC => {
+                let u = <foxglove::messages::SceneUpdate as prost::Message>::decode(&m.data[..])
+                    .unwrap();
+                let rod = u.entities.iter().find(|e| e.id == "rod").unwrap();
+                assert_eq!(rod.lines[0].points.len(), 42, "centreline points");
+                assert!(
+                    (rod.lines[0].thickness - 0.005).abs() < 1e-15,
+                    "tube of the rod's diameter"
+                );
+            }
+            TF_TOPIC => {
+                <foxglove::messages::FrameTransform as prost::Message>::decode(&m.data[..])
+                    .unwrap();
+            }
+            _ => {
+                let _: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+            }
+        }
+    }
+    let states = counts[SCALARS_TOPIC];
+    assert!(states > 3);
+    assert_eq!(counts[SCENE_TOPIC], states);
+    assert_eq!(counts[STATE_TOPIC], states);
+    let r = read_recording(&rec).unwrap();
+    assert!(r.metadata["scene"].contains("[continuation]"));
+    assert_eq!(r.metadata["knotrod_version"], env!("CARGO_PKG_VERSION"));
+    // info and export read it back
+    let out = knotrod(&["info", rec.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains(&format!("states: {states}")));
+    for fmt in ["csv", "json", "obj"] {
+        let out = knotrod(&[
+            "export",
+            rec.to_str().unwrap(),
+            "--index",
+            "2",
+            "--format",
+            fmt,
+        ]);
+        assert!(out.status.success() && !out.stdout.is_empty(), "{fmt}");
+    }
+}
+
+#[test]
+fn a_recorded_state_restarts_the_run_exactly() {
+    let dir = temp("restart");
+    let scene = short_branch_scene(&dir, "");
+    let rec = dir.join("run.mcap");
+    let json = dir.join("run.json");
+    let out = knotrod(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--record",
+        rec.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let k = 3;
+    let recorded = read_state(&rec, k).unwrap().state;
+    let from_summary: knotrod::model::rod::RodState =
+        serde_json::from_value(summary["equilibria"][k as usize]["state"].clone()).unwrap();
+    // exactly the computed state
+    for (a, b) in recorded.nodes.iter().zip(&from_summary.nodes) {
+        assert!((a - b).norm() <= 1e-12);
+    }
+    // restart a single solve from it: already in equilibrium, same energy
+    let phi = summary["equilibria"][k as usize]["phi_over_2pi"]
+        .as_f64()
+        .unwrap();
+    let restart = dir.join("restart.toml");
+    std::fs::write(
+        &restart,
+        format!(
+            "[model]\nsegments = 40\n[clamps]\nz_star = 0.115\ndelta = 0.05\nphi_over_2pi = {phi:.17}\n[initial]\nfrom_recording = {:?}\nindex = {k}\n",
+            rec.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let json2 = dir.join("restart.json");
+    let out = knotrod(&[
+        "run",
+        restart.to_str().unwrap(),
+        "--no-record",
+        "--json",
+        json2.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let again: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json2).unwrap()).unwrap();
+    let (e1, e2) = (
+        summary["equilibria"][k as usize]["energy"]
+            .as_f64()
+            .unwrap(),
+        again["equilibria"][0]["energy"].as_f64().unwrap(),
+    );
+    assert!((e1 - e2).abs() <= 1e-12 * e1, "{e1} vs {e2}");
+    assert!(again["equilibria"][0]["iterations"].as_u64().unwrap() <= 1);
+    let restarted: knotrod::model::rod::RodState =
+        serde_json::from_value(again["equilibria"][0]["state"].clone()).unwrap();
+    let moved = restarted
+        .nodes
+        .iter()
+        .zip(&recorded.nodes)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-10, "restart moved the state by {moved}");
+}
+
+#[test]
+fn interrupted_run_leaves_a_finalised_recording() {
+    let dir = temp("interrupt");
+    // a long branch so that it is still running when interrupted
+    let scene = short_branch_scene(&dir, "").to_str().unwrap().to_string();
+    let text = std::fs::read_to_string(&scene)
+        .unwrap()
+        .replace("range = [0.78, 0.84]", "range = [0.78, 1.5]")
+        .replace("segments = 40", "segments = 120");
+    std::fs::write(&scene, text).unwrap();
+    let rec = dir.join("run.mcap");
+    let json = dir.join("run.json");
+    let child = Command::new(env!("CARGO_BIN_EXE_knotrod"))
+        .args([
+            "run",
+            &scene,
+            "--record",
+            rec.to_str().unwrap(),
+            "--json",
+            json.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // wait for a few streamed equilibria, then Ctrl-C
+    let lines = dir.join("run.jsonl");
+    let start = std::time::Instant::now();
+    while std::fs::read_to_string(&lines).map_or(0, |t| t.lines().count()) < 5 {
+        assert!(
+            start.elapsed().as_secs() < 120,
+            "run produced no equilibria"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("interrupted") && !err.contains("panicked"),
+        "{err}"
+    );
+    let r = read_recording(&rec).expect("finalised, readable recording");
+    assert!(r.scalars.len() >= 5);
+    let bytes = std::fs::read(&rec).unwrap();
+    assert!(
+        mcap::Summary::read(&bytes).unwrap().is_some(),
+        "summary written"
+    );
+    // the JSON summary holds the same states
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(
+        summary["equilibria"].as_array().unwrap().len(),
+        r.scalars.len()
+    );
+}
+
+#[test]
+fn damaged_recordings_give_clear_errors() {
+    let dir = temp("damaged");
+    let scene = short_branch_scene(&dir, "");
+    let rec = dir.join("run.mcap");
+    assert!(
+        knotrod(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--record",
+            rec.to_str().unwrap()
+        ])
+        .status
+        .success()
+    );
+    let bytes = std::fs::read(&rec).unwrap();
+    let cut = dir.join("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let garbage = dir.join("garbage.mcap");
+    std::fs::write(&garbage, b"this is not an mcap file at all").unwrap();
+    for bad in [&cut, &garbage] {
+        let e = read_recording(bad)
+            .err()
+            .expect("damaged recording rejected")
+            .to_string();
+        assert!(e.contains("not a readable MCAP recording"), "{e}");
+        let out = knotrod(&["info", bad.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && !err.contains("panicked"), "{err}");
+    }
+    let e = read_state(&rec, 10_000).err().unwrap().to_string();
+    assert!(e.contains("no state with index 10000"), "{e}");
+}
