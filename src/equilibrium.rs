@@ -301,13 +301,23 @@ pub fn analyse(
     })
 }
 
-/// Solve a scene at N segments (the scene's own N if None).
-pub fn solve_scene(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
+/// The scene's starting equilibrium at N segments (the scene's if None): its
+/// initial shape relaxed by Newton, with the minimiser that found it.
+pub fn starting_equilibrium(
+    scene: &Scene,
+    segments: Option<usize>,
+) -> Result<(Newton, RodState, NewtonReport)> {
     let model = scene.rod_model(segments);
     let mut state = initial_state(scene, &model)?;
     let mut newton = Newton::new(RodEnergy::new(model));
     let report = newton
         .minimize(&mut state, &scene.solver)
         .context("Newton minimisation")?;
+    Ok((newton, state, report))
+}
+
+/// Solve a scene's single equilibrium at N segments (the scene's own N if None).
+pub fn solve_scene(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
+    let (mut newton, state, report) = starting_equilibrium(scene, segments)?;
     analyse(&mut newton, &state, &report, &Measure::of(scene))
 }

@@ -2,9 +2,8 @@
 //! optionally swept over a second parameter).
 
 use crate::branch::{BranchOptions, BranchRun, Event, Observer, label_events};
-use crate::equilibrium::{Measure, analyse, initial_state};
+use crate::equilibrium::{Measure, analyse, starting_equilibrium};
 use crate::loading::run_loading;
-use crate::model::energy::RodEnergy;
 use crate::model::rod::{Parameter, RodState};
 use crate::scene::{Direction, Scene};
 use crate::solve::continuation::{ContinuationSettings, Point, Tracer};
@@ -74,12 +73,7 @@ pub fn run_scene(
     segments: Option<usize>,
     observer: &mut Observer<'_>,
 ) -> Result<Vec<Event>> {
-    let model = scene.rod_model(segments);
-    let mut state = initial_state(scene, &model)?;
-    let mut newton = Newton::new(RodEnergy::new(model));
-    let report = newton
-        .minimize(&mut state, &scene.solver)
-        .context("Newton minimisation")?;
+    let (mut newton, mut state, report) = starting_equilibrium(scene, segments)?;
     let measure = Measure::of(scene);
     if !scene.loading.is_empty() {
         let mut events = run_loading(

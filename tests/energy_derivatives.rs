@@ -5,17 +5,8 @@ use knotrod::model::energy::{RodEnergy, Terms};
 use knotrod::model::rod::{Clamps, RodModel, RodState};
 use nalgebra::Vector3;
 
-/// A deterministic pseudo-random sequence (no extra dependency needed).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-}
+mod common;
+use common::Lcg;
 
 fn random_state(n: usize, seed: u64) -> (RodModel, RodState) {
     let model = RodModel {

@@ -286,8 +286,7 @@ fn damaged_recordings_give_clear_errors() {
     std::fs::write(&garbage, b"this is not an mcap file at all").unwrap();
     for bad in [&cut, &garbage] {
         let e = read_recording(bad)
-            .err()
-            .expect("damaged recording rejected")
+            .expect_err("damaged recording rejected")
             .to_string();
         assert!(e.contains("not a readable MCAP recording"), "{e}");
         let out = knotrod(&["info", bad.to_str().unwrap()]);

@@ -83,10 +83,6 @@ impl<'a> CurveTree<'a> {
         }
         id
     }
-
-    fn segment(&self, k: usize) -> (&Vector3<f64>, &Vector3<f64>) {
-        (&self.points[k], &self.points[k + 1])
-    }
 }
 
 /// The closest approach of two parts of a curve.
@@ -98,6 +94,19 @@ pub struct Approach {
     pub s: [f64; 2],
     /// The two segments.
     pub segments: [usize; 2],
+}
+
+/// Closest approach of segments i and j of a polyline.
+fn approach(points: &[Vector3<f64>], arc: &[f64], i: usize, j: usize) -> Approach {
+    let (d, ta, tb) = segment_distance(&points[i], &points[i + 1], &points[j], &points[j + 1]);
+    Approach {
+        distance: d,
+        s: [
+            arc[i] + ta * (arc[i + 1] - arc[i]),
+            arc[j] + tb * (arc[j + 1] - arc[j]),
+        ],
+        segments: [i, j],
+    }
 }
 
 /// Minimum distance between segments of the polyline `points` (arc length
@@ -127,19 +136,10 @@ pub fn min_self_distance(points: &[Vector3<f64>], arc: &[f64], gap: f64) -> Opti
                         if arc[j] - arc[i + 1] < gap {
                             continue;
                         }
-                        let (a0, a1) = tree.segment(i);
-                        let (b0, b1) = tree.segment(j);
-                        let (d, ta, tb) = segment_distance(a0, a1, b0, b1);
-                        if d < bound {
-                            bound = d;
-                            best = Some(Approach {
-                                distance: d,
-                                s: [
-                                    arc[i] + ta * (arc[i + 1] - arc[i]),
-                                    arc[j] + tb * (arc[j + 1] - arc[j]),
-                                ],
-                                segments: [i, j],
-                            });
+                        let a = approach(points, arc, i, j);
+                        if a.distance < bound {
+                            bound = a.distance;
+                            best = Some(a);
                         }
                     }
                 }
@@ -182,17 +182,9 @@ pub fn min_self_distance_brute(points: &[Vector3<f64>], arc: &[f64], gap: f64) -
             if arc[j] - arc[i + 1] < gap {
                 continue;
             }
-            let (d, ta, tb) =
-                segment_distance(&points[i], &points[i + 1], &points[j], &points[j + 1]);
-            if best.is_none_or(|b| d < b.distance) {
-                best = Some(Approach {
-                    distance: d,
-                    s: [
-                        arc[i] + ta * (arc[i + 1] - arc[i]),
-                        arc[j] + tb * (arc[j + 1] - arc[j]),
-                    ],
-                    segments: [i, j],
-                });
+            let a = approach(points, arc, i, j);
+            if best.is_none_or(|b| a.distance < b.distance) {
+                best = Some(a);
             }
         }
     }
