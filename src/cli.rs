@@ -86,6 +86,28 @@ pub enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Map the good-knot region: a branch in φ per value of a second parameter.
+    Map {
+        /// Scene with [continuation] (the branches) and [map] (the grid).
+        scene: PathBuf,
+        /// Write the map here (default recordings/<scene>.map.json).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Compute only shard i of n ("i/n") and write a partial result.
+        #[arg(long)]
+        shard: Option<String>,
+        /// Override the scene's number of segments.
+        #[arg(long)]
+        segments: Option<usize>,
+    },
+    /// Join partial maps (from `map --shard`) into one map.
+    Merge {
+        /// Partial results.
+        parts: Vec<PathBuf>,
+        /// Write the map here.
+        #[arg(long)]
+        json: PathBuf,
+    },
     /// Regenerate the validation report (docs/validation.md) on stdout.
     Validate {
         /// Folder holding the scenes.
@@ -180,6 +202,16 @@ pub fn main_with(cli: Cli) -> Result<()> {
                 writeln!(std::io::stdout().lock(), "plot written to {}", f.display())?;
             }
             Ok(())
+        }
+        Command::Map {
+            scene,
+            json,
+            shard,
+            segments,
+        } => map_command(&scene, json, shard.as_deref(), segments),
+        Command::Merge { parts, json } => {
+            let map = crate::map::merge(&parts)?;
+            write_map(&map, &json)
         }
         Command::Validate { scenes } => {
             write!(std::io::stdout().lock(), "{}", validation::report(&scenes)?)?;
@@ -450,4 +482,124 @@ fn polynomial(c: &[i64]) -> String {
         };
     }
     s
+}
+
+fn write_map(map: &crate::map::Map, json: &Path) -> Result<()> {
+    if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
+    std::fs::write(json, serde_json::to_string_pretty(map)? + "\n")
+        .with_context(|| format!("writing {}", json.display()))?;
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "map of {} over {} lines: good area {:.6}",
+        map.scene,
+        map.lines.len(),
+        map.good_area
+    )?;
+    for (k, v) in &map.bounding_box {
+        writeln!(out, "  good knots for {k} in [{:.5}, {:.5}]", v[0], v[1])?;
+    }
+    for l in &map.lines {
+        let iv: Vec<String> = l
+            .intervals
+            .iter()
+            .map(|i| {
+                format!(
+                    "[{:.4} ({}), {:.4} ({})]",
+                    i.lo, i.lo_label, i.hi, i.hi_label
+                )
+            })
+            .collect();
+        writeln!(
+            out,
+            "  {} = {:.4}: {}{}",
+            map.parameter,
+            l.value,
+            if iv.is_empty() {
+                "no good knots".into()
+            } else {
+                iv.join(" ")
+            },
+            l.error
+                .as_deref()
+                .map(|e| format!(" (FAILED: {e})"))
+                .unwrap_or_default()
+        )?;
+    }
+    writeln!(out, "map written to {}", json.display())?;
+    for f in crate::plot::island_map(&json.with_extension(""), map)? {
+        writeln!(out, "plot written to {}", f.display())?;
+    }
+    Ok(())
+}
+
+fn map_command(
+    path: &Path,
+    json: Option<PathBuf>,
+    shard: Option<&str>,
+    segments: Option<usize>,
+) -> Result<()> {
+    let scene = Scene::load(path)?;
+    let spec = scene
+        .map
+        .clone()
+        .context("the scene has no [map] section")?;
+    let cont = scene
+        .continuation
+        .as_ref()
+        .context("the scene has no [continuation] section")?;
+    let name = scene.name.clone().unwrap_or_else(|| "map".into());
+    let json = json.unwrap_or_else(|| PathBuf::from("recordings").join(format!("{name}.map.json")));
+    let shard = match shard {
+        Some(s) => Some(crate::map::parse_shard(s)?),
+        None => None,
+    };
+    let indices = match shard {
+        Some(sh) => crate::map::shard_lines(&spec, sh),
+        None => (0..spec.lines).collect(),
+    };
+    // computed lines are kept beside the output: an interrupted map resumes
+    let cache = json.with_extension("lines");
+    let progress = indicatif::ProgressBar::new(indices.len() as u64);
+    progress.set_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} lines, ETA {eta} — {msg}")
+            .unwrap(),
+    );
+    let lines = crate::map::compute_lines(&scene, &spec, &indices, segments, &cache, &|l| {
+        progress.inc(1);
+        progress.set_message(format!(
+            "{} = {:.4}: {} good intervals",
+            spec.parameter.name(),
+            l.value,
+            l.intervals.len()
+        ));
+    })?;
+    progress.finish_and_clear();
+    match shard {
+        Some(sh) => {
+            let part = crate::map::Partial {
+                scene: name,
+                spec,
+                phi_range: cont.range,
+                shard: sh,
+                lines,
+            };
+            std::fs::write(&json, serde_json::to_string_pretty(&part)? + "\n")
+                .with_context(|| format!("writing {}", json.display()))?;
+            writeln!(
+                std::io::stdout().lock(),
+                "partial map (shard {}/{}) written to {}",
+                sh.0,
+                sh.1,
+                json.display()
+            )?;
+            Ok(())
+        }
+        None => write_map(
+            &crate::map::assemble(&name, &spec, cont.range, lines),
+            &json,
+        ),
+    }
 }

@@ -8,6 +8,7 @@ pub mod equilibrium;
 pub mod export;
 pub mod geometry;
 pub mod loading;
+pub mod map;
 pub mod model;
 pub mod plot;
 pub mod record;

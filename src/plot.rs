@@ -294,3 +294,83 @@ pub fn bifurcation_diagram(
     }
     Ok(written)
 }
+
+/// The island map: classified grid as dots (colours as in the diagrams) and
+/// the boundary curves labelled, in the (φ/2π, swept parameter) plane.
+pub fn island_map(stem: &Path, map: &crate::map::Map) -> Result<Vec<std::path::PathBuf>> {
+    let mut written = Vec::new();
+    let fonts = font_available();
+    let svg = stem.with_extension("svg");
+    draw_map(SVGBackend::new(&svg, (900, 700)).into_drawing_area(), map)?;
+    written.push(svg);
+    if fonts {
+        let png = stem.with_extension("png");
+        draw_map(
+            BitMapBackend::new(&png, (900, 700)).into_drawing_area(),
+            map,
+        )?;
+        written.push(png);
+    }
+    Ok(written)
+}
+
+fn draw_map<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, map: &crate::map::Map) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    use crate::map::Class;
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plot: {e:?}");
+    root.fill(&WHITE).map_err(err)?;
+    let (x0, x1) = bounds(&map.grid_phi);
+    let values: Vec<f64> = map.lines.iter().map(|l| l.value).collect();
+    let (y0, y1) = bounds(&values);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{}: good knots", map.scene), ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("φ/2π")
+        .y_desc(map.parameter.as_str())
+        .draw()
+        .map_err(err)?;
+    for (row, l) in map.grid.iter().zip(&map.lines) {
+        for (c, phi) in row.iter().zip(&map.grid_phi) {
+            let col = match c {
+                Class::Good => RGBColor(40, 160, 60),
+                Class::StableUnwalled => RGBColor(40, 90, 200),
+                Class::Unknotted => RGBColor(150, 95, 40),
+                Class::Unstable => RGBColor(210, 40, 40),
+                Class::None => continue,
+            };
+            chart
+                .draw_series(std::iter::once(Circle::new(
+                    (*phi, l.value),
+                    2,
+                    col.filled(),
+                )))
+                .map_err(err)?;
+        }
+    }
+    for (name, pts) in &map.boundaries {
+        let mut pts: Vec<(f64, f64)> = pts.iter().map(|p| (p[1], p[0])).collect();
+        pts.sort_by(|a, b| a.1.total_cmp(&b.1));
+        chart
+            .draw_series(LineSeries::new(pts.clone(), BLACK.stroke_width(2)))
+            .map_err(err)?;
+        if let Some(&(x, y)) = pts.get(pts.len() / 2) {
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    name.clone(),
+                    (x, y),
+                    ("sans-serif", 16).into_font().color(&BLACK),
+                )))
+                .map_err(err)?;
+        }
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}

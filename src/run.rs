@@ -26,7 +26,7 @@ pub fn reach(
         return Ok(state);
     }
     let sign = (target - now).signum();
-    let mut a = tracer.start(state, sign)?;
+    let mut a = tracer.start(state, sign).context("tangent at the start")?;
     let mut ds = settings.step;
     for _ in 0..settings.max_points {
         let pa = tracer.parameter_of(&a.state);
@@ -45,13 +45,23 @@ pub fn reach(
         };
         let pb = tracer.parameter_of(&b.state);
         if (pb - target) * (pa - target) <= 0.0 {
-            // Newton at fixed parameter: a corrector along the parameter axis
+            // the point of the branch nearest the target, then Newton at fixed
+            // parameter: a corrector along the parameter axis
+            let below = (pa - target).signum();
+            let near = tracer
+                .locate(&a, ds, &mut |t, p| {
+                    (t.parameter_of(&p.state) - target).signum() == below
+                })
+                .context("locating the target value")?;
             let axis = Point {
-                tangent_q: vec![0.0; a.tangent_q.len()],
+                tangent_q: vec![0.0; near.tangent_q.len()],
                 tangent_p: 1.0,
-                ..a.clone()
+                ..near.clone()
             };
-            let p = tracer.correct(&axis, target - pa, None)?;
+            let pn = tracer.parameter_of(&near.state);
+            let p = tracer
+                .correct(&axis, target - pn, None)
+                .context("Newton at the target value")?;
             return Ok(p.state);
         }
         if b.iterations <= 3 {

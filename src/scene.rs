@@ -40,6 +40,9 @@ pub struct Scene {
     /// minimisation from the previous equilibrium (jumps detected).
     #[serde(default)]
     pub loading: Vec<LoadingSpec>,
+    /// Parameter-space map (with `knotrod map`).
+    #[serde(default)]
+    pub map: Option<crate::map::MapSpec>,
     /// Knot diagnostics settings.
     #[serde(default)]
     pub diagnostics: DiagnosticsSpec,
@@ -532,6 +535,19 @@ impl Scene {
                     "sweep.parameter",
                     "must differ from continuation.parameter",
                 ));
+            }
+        }
+        if let Some(m) = &self.map {
+            if self.continuation.is_none() {
+                return Err(invalid("map", "needs a [continuation] giving the branches"));
+            }
+            finite("map.range", m.range[0])?;
+            finite("map.range", m.range[1])?;
+            if m.lines == 0 || m.lines > 100_000 {
+                return Err(invalid("map.lines", "must be in 1..=100000"));
+            }
+            if m.grid_columns < 2 {
+                return Err(invalid("map.grid_columns", "must be >= 2"));
             }
         }
         let d = &self.diagnostics;

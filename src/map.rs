@@ -1,0 +1,492 @@
+//! Parameter-space maps: the island of good knots (paper Fig. 7) from a grid of
+//! one-parameter branches — a branch in φ at each value of a second parameter
+//! (z*), each reached independently by continuation from the scene's start,
+//! computed in parallel (rayon) and deterministic whatever the thread count.
+//! Good intervals are bounded by the located events (S, W1, W2, X), which form
+//! the boundary curves. Maps shard (`--shard i/n`, `knotrod merge`) and resume
+//! from the lines already written.
+
+use crate::branch::{BranchOptions, BranchRun, Event};
+use crate::equilibrium::{Equilibrium, Measure, starting_equilibrium};
+use crate::model::rod::Parameter;
+use crate::run::reach;
+use crate::scene::Scene;
+use crate::solve::continuation::ContinuationSettings;
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Class of a point of the map, as coloured in the paper.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Class {
+    /// Walled, knotted, stable, contact-free.
+    Good,
+    /// Stable and knotted, not walled.
+    StableUnwalled,
+    /// Stable, not knotted.
+    Unknotted,
+    /// Unstable.
+    Unstable,
+    /// No equilibrium of the followed branch there.
+    None,
+}
+
+/// The paper's good knot (its X boundary is the self-crossing, the rod being
+/// thin): stable, walled, trefoil.
+pub fn class_of(stable: bool, walled: bool, knot_determinant: u64) -> Class {
+    match (stable, knot_determinant == 3, walled) {
+        (false, _, _) => Class::Unstable,
+        (true, false, _) => Class::Unknotted,
+        (true, true, true) => Class::Good,
+        (true, true, false) => Class::StableUnwalled,
+    }
+}
+
+/// A point of a line of the map.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct LinePoint {
+    /// φ/2π.
+    pub phi_over_2pi: f64,
+    /// Tw.
+    pub twist: f64,
+    /// Class.
+    pub class: Class,
+}
+
+/// An interval of good knots along a line, with what bounds it.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Interval {
+    /// Lower φ/2π.
+    pub lo: f64,
+    /// Upper φ/2π.
+    pub hi: f64,
+    /// Boundary label at the lower end (S, W1, X, range, ...).
+    pub lo_label: String,
+    /// Boundary label at the upper end (W2, X, S, range, ...).
+    pub hi_label: String,
+}
+
+/// One line of the map: the branch in φ at one value of the swept parameter.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Line {
+    /// Index in the map's grid.
+    pub index: usize,
+    /// Value of the swept parameter.
+    pub value: f64,
+    /// The branch, in order along its arclength.
+    pub points: Vec<LinePoint>,
+    /// Located events.
+    pub events: Vec<Event>,
+    /// Good intervals.
+    pub intervals: Vec<Interval>,
+    /// Why the line failed, if it did.
+    pub error: Option<String>,
+}
+
+/// A map: lines, classified grid, boundary curves, area and bounding box.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Map {
+    /// Scene name.
+    pub scene: String,
+    /// The swept parameter (the map's vertical axis).
+    pub parameter: String,
+    /// Lines, by increasing index.
+    pub lines: Vec<Line>,
+    /// Named boundary curves: (swept value, φ/2π) points.
+    pub boundaries: BTreeMap<String, Vec<[f64; 2]>>,
+    /// Classified grid: rows = lines, columns = `grid_phi`.
+    pub grid: Vec<Vec<Class>>,
+    /// φ/2π of the grid columns.
+    pub grid_phi: Vec<f64>,
+    /// Area of the good region in the (swept, φ/2π) plane.
+    pub good_area: f64,
+    /// {"swept": [lo, hi], "phi_over_2pi": [lo, hi]} of the good region.
+    pub bounding_box: BTreeMap<String, [f64; 2]>,
+}
+
+/// The map settings of a scene: `[map]`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapSpec {
+    /// The swept parameter (default z_star).
+    #[serde(default = "default_sweep")]
+    pub parameter: Parameter,
+    /// Its values, evenly spaced from range[0] to range[1].
+    pub range: [f64; 2],
+    /// Number of lines.
+    pub lines: usize,
+    /// Columns of the classified grid.
+    #[serde(default = "default_columns")]
+    pub grid_columns: usize,
+}
+
+fn default_sweep() -> Parameter {
+    Parameter::ZStar
+}
+fn default_columns() -> usize {
+    101
+}
+
+impl MapSpec {
+    /// Value of line k.
+    pub fn value(&self, k: usize) -> f64 {
+        if self.lines == 1 {
+            return self.range[0];
+        }
+        self.range[0] + (self.range[1] - self.range[0]) * k as f64 / (self.lines - 1) as f64
+    }
+}
+
+/// Points ordered along the branch (second leg reversed, then the first).
+fn ordered(eqs: &[Equilibrium]) -> Vec<&Equilibrium> {
+    let mut down: Vec<&Equilibrium> = eqs.iter().filter(|e| e.branch == 0 && e.leg == 1).collect();
+    down.reverse();
+    down.into_iter()
+        .chain(eqs.iter().filter(|e| e.branch == 0 && e.leg == 0))
+        .collect()
+}
+
+/// The event that bounds a good run between branch points `p` and `q`: the one
+/// nearest to that segment in the (φ/2π, Tw) plane (the branch may pass the
+/// same φ several times).
+fn boundary_label(events: &[Event], p: &LinePoint, q: &LinePoint, lower: bool) -> (f64, String) {
+    let (ax, ay, bx, by) = (p.phi_over_2pi, p.twist, q.phi_over_2pi, q.twist);
+    let dist = |e: &Event| {
+        let (dx, dy) = (bx - ax, by - ay);
+        let len2 = (dx * dx + dy * dy).max(1e-300);
+        let t = (((e.phi_over_2pi - ax) * dx + (e.twist - ay) * dy) / len2).clamp(0.0, 1.0);
+        ((e.phi_over_2pi - ax - t * dx).powi(2) + (e.twist - ay - t * dy).powi(2)).sqrt()
+    };
+    let scale = ((bx - ax).powi(2) + (by - ay).powi(2)).sqrt();
+    let best = events
+        .iter()
+        .filter(|e| {
+            e.branch == 0
+                && matches!(
+                    e.kind.as_str(),
+                    "wall" | "crossing" | "branch_point" | "fold"
+                )
+        })
+        // the event lies on the arc between the two points: near their chord
+        .filter(|e| dist(e) <= 0.3 * scale + 1e-9)
+        .min_by(|x, y| dist(x).total_cmp(&dist(y)));
+    match best {
+        Some(e) => {
+            let label = match (e.kind.as_str(), lower) {
+                ("wall", true) => "W1",
+                ("wall", false) => "W2",
+                ("crossing", _) => "X",
+                ("fold", _) => "F",
+                _ => "S",
+            };
+            (e.phi_over_2pi, label.to_string())
+        }
+        None => (0.5 * (ax + bx), "?".to_string()),
+    }
+}
+
+/// Good intervals of a line: maximal runs of good points, bounded by the
+/// events between their ends and the neighbouring points.
+pub fn intervals_of(points: &[LinePoint], events: &[Event]) -> Vec<Interval> {
+    let mut intervals = Vec::new();
+    let good: Vec<bool> = points.iter().map(|p| p.class == Class::Good).collect();
+    let mut k = 0;
+    while k < good.len() {
+        if !good[k] {
+            k += 1;
+            continue;
+        }
+        let start = k;
+        while k < good.len() && good[k] {
+            k += 1;
+        }
+        let end = k - 1;
+        let phi = |i: usize| points[i].phi_over_2pi;
+        let (a, la) = if start == 0 {
+            (phi(0), "range".to_string())
+        } else {
+            boundary_label(
+                events,
+                &points[start - 1],
+                &points[start],
+                phi(start - 1) < phi(start),
+            )
+        };
+        let (b, lb) = if end + 1 == good.len() {
+            (phi(end), "range".to_string())
+        } else {
+            boundary_label(
+                events,
+                &points[end],
+                &points[end + 1],
+                phi(end + 1) < phi(end),
+            )
+        };
+        let (lo, hi, lo_label, hi_label) = if a <= b {
+            (a, b, la, lb)
+        } else {
+            (b, a, lb, la)
+        };
+        intervals.push(Interval {
+            lo,
+            hi,
+            lo_label,
+            hi_label,
+        });
+    }
+    intervals
+}
+
+/// Compute line `index` of the map.
+pub fn line(scene: &Scene, spec: &MapSpec, index: usize, segments: Option<usize>) -> Line {
+    let value = spec.value(index);
+    let mut out = Line {
+        index,
+        value,
+        points: vec![],
+        events: vec![],
+        intervals: vec![],
+        error: None,
+    };
+    match compute_line(scene, spec, value, segments) {
+        Ok((eqs, events)) => {
+            let ord = ordered(&eqs);
+            out.points = ord
+                .iter()
+                .map(|e| LinePoint {
+                    phi_over_2pi: e.phi_over_2pi,
+                    twist: e.twist,
+                    class: class_of(e.stable, e.walled, e.knot_determinant),
+                })
+                .collect();
+            out.intervals = intervals_of(&out.points, &events);
+            out.events = events;
+        }
+        Err(e) => out.error = Some(format!("{e:#}")),
+    }
+    out
+}
+
+fn compute_line(
+    scene: &Scene,
+    spec: &MapSpec,
+    value: f64,
+    segments: Option<usize>,
+) -> Result<(Vec<Equilibrium>, Vec<Event>)> {
+    let c = scene
+        .continuation
+        .as_ref()
+        .context("[map] needs a [continuation] in φ")?;
+    let (mut newton, state, _) = starting_equilibrium(scene, segments)?;
+    let defaults = ContinuationSettings::default();
+    let settings = ContinuationSettings {
+        step: c.step.unwrap_or(defaults.step),
+        max_step: c.max_step.unwrap_or(defaults.max_step),
+        max_points: c.max_points.map_or(defaults.max_points, |m| m as usize),
+        ..defaults
+    };
+    let state = reach(&mut newton, state, spec.parameter, value, &settings)?;
+    let options = BranchOptions {
+        parameter: c.parameter,
+        range: c.range,
+        settings,
+        locate_events: true,
+        switch_branches: false,
+        measure: Measure {
+            eigenvalues: 0,
+            ..Measure::of(scene)
+        },
+    };
+    let mut eqs = Vec::new();
+    let mut obs = |e: Equilibrium| {
+        eqs.push(e);
+        Ok(())
+    };
+    let mut run = BranchRun::new(&mut newton, options, &mut obs, 0);
+    run.run(state, &[1.0, -1.0])?;
+    let events = std::mem::take(&mut run.events);
+    drop(run);
+    Ok((eqs, events))
+}
+
+/// Lines of shard `i` of `n`.
+pub fn shard_lines(spec: &MapSpec, shard: (usize, usize)) -> Vec<usize> {
+    (0..spec.lines).filter(|k| k % shard.1 == shard.0).collect()
+}
+
+/// Compute (or load from `cache`) the given lines in parallel, reporting each.
+pub fn compute_lines(
+    scene: &Scene,
+    spec: &MapSpec,
+    indices: &[usize],
+    segments: Option<usize>,
+    cache: &Path,
+    on_line: &(dyn Fn(&Line) + Sync),
+) -> Result<Vec<Line>> {
+    use rayon::prelude::*;
+    std::fs::create_dir_all(cache).with_context(|| format!("creating {}", cache.display()))?;
+    let mut lines: Vec<Line> = indices
+        .par_iter()
+        .map(|&k| -> Result<Line> {
+            let file = cache.join(format!("line_{k:05}.json"));
+            // resume: a line already written is not computed again
+            if let Some(l) = std::fs::read_to_string(&file)
+                .ok()
+                .and_then(|t| serde_json::from_str::<Line>(&t).ok())
+            {
+                if l.index == k && l.value == spec.value(k) {
+                    on_line(&l);
+                    return Ok(l);
+                }
+            }
+            let l = line(scene, spec, k, segments);
+            let tmp = file.with_extension("json.tmp");
+            std::fs::write(&tmp, serde_json::to_vec(&l)?)?;
+            std::fs::rename(&tmp, &file)?;
+            on_line(&l);
+            Ok(l)
+        })
+        .collect::<Result<Vec<Line>>>()?;
+    lines.sort_by_key(|l| l.index);
+    Ok(lines)
+}
+
+/// Assemble a map from its lines (boundaries, grid, area, bounding box).
+pub fn assemble(
+    scene_name: &str,
+    spec: &MapSpec,
+    phi_range: [f64; 2],
+    mut lines: Vec<Line>,
+) -> Map {
+    lines.sort_by_key(|l| l.index);
+    lines.dedup_by_key(|l| l.index);
+    for l in lines.iter_mut() {
+        l.intervals = intervals_of(&l.points, &l.events);
+    }
+    let grid_phi: Vec<f64> = (0..spec.grid_columns)
+        .map(|j| {
+            phi_range[0]
+                + (phi_range[1] - phi_range[0]) * j as f64 / (spec.grid_columns.max(2) - 1) as f64
+        })
+        .collect();
+    let grid = lines.iter().map(|l| grid_row(l, &grid_phi)).collect();
+    let mut boundaries: BTreeMap<String, Vec<[f64; 2]>> = BTreeMap::new();
+    let mut area = 0.0;
+    let (mut vlo, mut vhi, mut plo, mut phi_hi) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    let widths: Vec<f64> = lines
+        .iter()
+        .map(|l| l.intervals.iter().map(|i| i.hi - i.lo).sum())
+        .collect();
+    for (k, l) in lines.iter().enumerate() {
+        for i in &l.intervals {
+            boundaries
+                .entry(i.lo_label.clone())
+                .or_default()
+                .push([l.value, i.lo]);
+            boundaries
+                .entry(i.hi_label.clone())
+                .or_default()
+                .push([l.value, i.hi]);
+            vlo = vlo.min(l.value);
+            vhi = vhi.max(l.value);
+            plo = plo.min(i.lo);
+            phi_hi = phi_hi.max(i.hi);
+        }
+        if k > 0 {
+            area += 0.5 * (widths[k] + widths[k - 1]) * (l.value - lines[k - 1].value);
+        }
+    }
+    let mut bounding_box = BTreeMap::new();
+    if vlo.is_finite() {
+        bounding_box.insert(spec.parameter.name().to_string(), [vlo, vhi]);
+        bounding_box.insert("phi_over_2pi".to_string(), [plo, phi_hi]);
+    }
+    Map {
+        scene: scene_name.into(),
+        parameter: spec.parameter.name().into(),
+        lines,
+        boundaries,
+        grid,
+        grid_phi,
+        good_area: area,
+        bounding_box,
+    }
+}
+
+/// Class of a line at each grid φ: the stable state if several, else the first.
+fn grid_row(l: &Line, phis: &[f64]) -> Vec<Class> {
+    phis.iter()
+        .map(|&phi| {
+            let mut found: Option<Class> = None;
+            for w in l.points.windows(2) {
+                let (a, b) = (w[0].phi_over_2pi, w[1].phi_over_2pi);
+                if (a - phi) * (b - phi) <= 0.0 && a != b {
+                    let c = if (phi - a).abs() <= (phi - b).abs() {
+                        w[0].class
+                    } else {
+                        w[1].class
+                    };
+                    if found.is_none() || (found == Some(Class::Unstable) && c != Class::Unstable) {
+                        found = Some(c);
+                    }
+                }
+            }
+            found.unwrap_or(Class::None)
+        })
+        .collect()
+}
+
+/// Parse "i/n".
+pub fn parse_shard(s: &str) -> Result<(usize, usize)> {
+    let (i, n) = s.split_once('/').context("--shard takes i/n")?;
+    let (i, n): (usize, usize) = (i.trim().parse()?, n.trim().parse()?);
+    if n == 0 || i >= n {
+        bail!("--shard {s}: need 0 <= i < n");
+    }
+    Ok((i, n))
+}
+
+/// A partial result of shard i/n.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Partial {
+    /// Scene name.
+    pub scene: String,
+    /// The map settings.
+    pub spec: MapSpec,
+    /// φ range of the lines.
+    pub phi_range: [f64; 2],
+    /// Shard (i, n).
+    pub shard: (usize, usize),
+    /// Its lines.
+    pub lines: Vec<Line>,
+}
+
+/// Merge partial results into a map.
+pub fn merge(parts: &[PathBuf]) -> Result<Map> {
+    let mut all = Vec::new();
+    let mut head: Option<Partial> = None;
+    for p in parts {
+        let text =
+            std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))?;
+        let part: Partial = serde_json::from_str(&text)
+            .with_context(|| format!("{} is not a partial map", p.display()))?;
+        all.extend(part.lines.clone());
+        head.get_or_insert(part);
+    }
+    let h = head.context("merge needs at least one partial result")?;
+    let map = assemble(&h.scene, &h.spec, h.phi_range, all);
+    let missing: Vec<usize> = (0..h.spec.lines)
+        .filter(|k| !map.lines.iter().any(|l| l.index == *k))
+        .collect();
+    if !missing.is_empty() {
+        bail!("merge: lines {missing:?} are missing (a shard was not merged)");
+    }
+    Ok(map)
+}
