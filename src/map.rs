@@ -335,11 +335,11 @@ pub fn compute_lines(
             if let Some(l) = std::fs::read_to_string(&file)
                 .ok()
                 .and_then(|t| serde_json::from_str::<Line>(&t).ok())
+                && l.index == k
+                && l.value == spec.value(k)
             {
-                if l.index == k && l.value == spec.value(k) {
-                    on_line(&l);
-                    return Ok(l);
-                }
+                on_line(&l);
+                return Ok(l);
             }
             let l = line(scene, spec, k, segments);
             let tmp = file.with_extension("json.tmp");
