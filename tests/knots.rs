@@ -205,3 +205,57 @@ fn bracket_passage(family: &dyn Fn(f64) -> Vec<Vector3<f64>>) -> (f64, f64) {
     }
     (lo, hi)
 }
+
+/// Fuller's formula (1978): for closed curves C0, C1 with tangents T0(t),
+/// T1(t) never opposite, Wr(C1) − Wr(C0) = (1/2π) ∮ (T0 × T1)·(T0' + T1') /
+/// (1 + T0·T1) dt. A single smooth periodic integral (spectrally accurate by the
+/// trapezoidal rule): an independent reference for the polygon's double sum.
+fn fuller_writhe_difference(
+    t0: impl Fn(f64) -> Vector3<f64>,
+    t1: impl Fn(f64) -> Vector3<f64>,
+    m: usize,
+) -> f64 {
+    let h = 2.0 * PI / m as f64;
+    let d = 1e-5;
+    (0..m)
+        .map(|k| {
+            let t = k as f64 * h;
+            let (a, b) = (t0(t), t1(t));
+            let da = (t0(t + d) - t0(t - d)) / (2.0 * d);
+            let db = (t1(t + d) - t1(t - d)) / (2.0 * d);
+            a.cross(&b).dot(&(da + db)) / (1.0 + a.dot(&b))
+        })
+        .sum::<f64>()
+        * h
+        / (2.0 * PI)
+}
+
+#[test]
+fn writhe_of_a_closed_helix_matches_fullers_formula() {
+    // a helix of n turns wound on a circle (closed on itself); reference: the
+    // circle, of writhe 0
+    for (n, a) in [(3.0, 0.1), (5.0, 0.06), (8.0, 0.03)] {
+        let r = |t: f64| {
+            Vector3::new(
+                (1.0 + a * (n * t).cos()) * t.cos(),
+                (1.0 + a * (n * t).cos()) * t.sin(),
+                a * (n * t).sin(),
+            )
+        };
+        let dr = |t: f64| (r(t + 1e-6) - r(t - 1e-6)) / 2e-6;
+        let t1 = |t: f64| dr(t).normalize();
+        let t0 = |t: f64| Vector3::new(-t.sin(), t.cos(), 0.0);
+        let exact = fuller_writhe_difference(t0, t1, 4000);
+        // the polygon converges as 1/M²: Richardson from M and 2M
+        let (w1, w2) = (
+            writhe_closed(&curve(1000, r)),
+            writhe_closed(&curve(2000, r)),
+        );
+        let extrapolated = (4.0 * w2 - w1) / 3.0;
+        assert!(
+            (extrapolated - exact).abs() < 1e-6,
+            "n = {n}: polygon {extrapolated} vs Fuller {exact}"
+        );
+        assert!(exact.abs() > 0.01, "a non-trivial writhe");
+    }
+}
