@@ -108,6 +108,15 @@ pub enum Command {
         #[arg(long)]
         json: PathBuf,
     },
+    /// Time the standard workloads and the growth of per-step costs with N.
+    Bench {
+        /// Folder holding the scenes.
+        #[arg(long, default_value = "scenes")]
+        scenes: PathBuf,
+        /// Also write the report as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Regenerate the validation report (docs/validation.md) on stdout.
     Validate {
         /// Folder holding the scenes.
@@ -212,6 +221,15 @@ pub fn main_with(cli: Cli) -> Result<()> {
         Command::Merge { parts, json } => {
             let map = crate::map::merge(&parts)?;
             write_map(&map, &json)
+        }
+        Command::Bench { scenes, json } => {
+            let r = crate::bench::run(&scenes)?;
+            crate::bench::print(&r, &mut std::io::stdout().lock())?;
+            if let Some(p) = json {
+                std::fs::write(&p, serde_json::to_string_pretty(&r)? + "\n")
+                    .with_context(|| format!("writing {}", p.display()))?;
+            }
+            Ok(())
         }
         Command::Validate { scenes } => {
             write!(std::io::stdout().lock(), "{}", validation::report(&scenes)?)?;

@@ -211,6 +211,8 @@ impl<'a> Tracer<'a> {
         let mut offset = vec![0.0; tq.len()];
         let mut p = p_pred;
         for it in 0..=self.settings.max_corrector_iterations {
+            crate::solve::counters::NEWTON_ITERATIONS
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let (rel, at_floor) = self.linearise(&state)?;
             let c = self.weight * dot(&tq, &offset) + tp * (p - p_pred);
             if (rel <= self.settings.tolerance || at_floor)

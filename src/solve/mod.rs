@@ -3,3 +3,12 @@
 pub mod continuation;
 pub mod newton;
 pub mod sparse;
+
+/// Process-wide work counters, read by `knotrod bench`.
+pub mod counters {
+    use std::sync::atomic::AtomicUsize;
+    /// Numerical sparse factorisations.
+    pub static FACTORIZATIONS: AtomicUsize = AtomicUsize::new(0);
+    /// Newton and corrector iterations (Hessian evaluations).
+    pub static NEWTON_ITERATIONS: AtomicUsize = AtomicUsize::new(0);
+}

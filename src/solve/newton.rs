@@ -132,6 +132,8 @@ impl Newton {
         let mut shift = 0.0f64;
         let mut trial = state.clone();
         for it in 0..=settings.max_iterations {
+            crate::solve::counters::NEWTON_ITERATIONS
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let info = self.energy.hessian(state, &mut self.grad, &mut self.values);
             let gnorm = norm(&self.grad);
             if !info.energy.is_finite() || !gnorm.is_finite() {

@@ -1,0 +1,244 @@
+//! `knotrod bench`: standard workloads timed with their work counts, and the
+//! growth of per-step costs with N (fitted exponents).
+
+use crate::equilibrium::{Measure, Shape};
+use crate::geometry::closure::ray_closure;
+use crate::geometry::distance::min_self_distance;
+use crate::geometry::knot::knot_type;
+use crate::geometry::writhe::writhe_closed;
+use crate::model::energy::RodEnergy;
+use crate::model::rod::RodState;
+use crate::scene::Scene;
+use crate::solve::counters::{FACTORIZATIONS, NEWTON_ITERATIONS};
+use crate::solve::sparse::Ldlt;
+use crate::stability::lowest_eigenvalues;
+use anyhow::{Context, Result};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+/// One timed workload.
+#[derive(Clone, Debug, Serialize)]
+pub struct Workload {
+    /// Name.
+    pub name: String,
+    /// N.
+    pub segments: usize,
+    /// Wall time.
+    pub seconds: f64,
+    /// Newton and corrector iterations.
+    pub newton_iterations: usize,
+    /// Sparse factorisations.
+    pub factorizations: usize,
+    /// Peak resident memory of the process so far (Linux VmHWM), bytes.
+    pub peak_bytes: u64,
+}
+
+/// The bench report.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Workloads.
+    pub workloads: Vec<Workload>,
+    /// Fitted exponent of cost versus N per operation (N = 200 … 3200).
+    pub exponents: BTreeMap<String, f64>,
+    /// Seconds per call, per operation and N.
+    pub per_call: BTreeMap<String, Vec<(usize, f64)>>,
+}
+
+fn peak_bytes() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .map(|l| l.to_string())
+        })
+        .and_then(|l| {
+            l.split_whitespace()
+                .nth(1)
+                .and_then(|v| v.parse::<u64>().ok())
+        })
+        .map_or(0, |kb| kb * 1024)
+}
+
+fn timed(name: &str, segments: usize, f: impl FnOnce() -> Result<()>) -> Result<Workload> {
+    let (it0, f0) = (
+        NEWTON_ITERATIONS.load(Ordering::Relaxed),
+        FACTORIZATIONS.load(Ordering::Relaxed),
+    );
+    let t = Instant::now();
+    f().with_context(|| format!("workload {name}"))?;
+    Ok(Workload {
+        name: name.into(),
+        segments,
+        seconds: t.elapsed().as_secs_f64(),
+        newton_iterations: NEWTON_ITERATIONS.load(Ordering::Relaxed) - it0,
+        factorizations: FACTORIZATIONS.load(Ordering::Relaxed) - f0,
+        peak_bytes: peak_bytes(),
+    })
+}
+
+/// Mean seconds per call of `f`, repeated for at least ~0.2 s.
+fn per_call(mut f: impl FnMut()) -> f64 {
+    f();
+    let t = Instant::now();
+    let mut n = 0;
+    while n < 3 || t.elapsed().as_secs_f64() < 0.2 {
+        f();
+        n += 1;
+    }
+    t.elapsed().as_secs_f64() / n as f64
+}
+
+/// Run the standard workloads from the scenes in `scenes`.
+pub fn run(scenes: &Path) -> Result<Report> {
+    let d = Scene::load(&scenes.join("appendix_d.toml"))?;
+    let fig3 = Scene::load(&scenes.join("fig3_kirchhoff.toml"))?;
+    let fig7 = Scene::load(&scenes.join("fig7_island_kirchhoff.toml"))?;
+    let mut workloads = Vec::new();
+    workloads.push(timed("appendix_d_from_shooting", 200, || {
+        crate::equilibrium::solve_scene(&d, Some(200)).map(|_| ())
+    })?);
+    let mut main_branch = fig3.clone();
+    if let Some(c) = main_branch.continuation.as_mut() {
+        c.switch_branches = false;
+    }
+    workloads.push(timed("figure_3_branch", 200, || {
+        crate::run::run_scene(&main_branch, Some(200), &mut |_| Ok(())).map(|_| ())
+    })?);
+    let mut island = fig7.clone();
+    if let Some(m) = island.map.as_mut() {
+        m.lines = 6;
+        m.range = [0.11, 0.21];
+    }
+    workloads.push(timed("figure_7_island_6_lines", 60, || {
+        let spec = island.map.clone().unwrap();
+        let cache = std::env::temp_dir().join(format!("knotrod-bench-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&cache);
+        let idx: Vec<usize> = (0..spec.lines).collect();
+        crate::map::compute_lines(&island, &spec, &idx, Some(60), &cache, &|_| {})?;
+        let _ = std::fs::remove_dir_all(&cache);
+        Ok(())
+    })?);
+    // per-operation costs on the Appendix D knot resampled at each N
+    let mut per: BTreeMap<String, Vec<(usize, f64)>> = BTreeMap::new();
+    for n in [200, 400, 800, 1600, 3200] {
+        let e = crate::equilibrium::solve_scene(&d, Some(n))?;
+        let state: RodState = e.state;
+        let energy = RodEnergy::new(d.rod_model(Some(n)));
+        let mut g = vec![0.0; energy.map.len()];
+        let mut v = vec![0.0; energy.pattern.nnz()];
+        energy.hessian(&state, &mut g, &mut v);
+        let mut ldlt = Ldlt::new(&energy.pattern);
+        let mut push = |name: &str, t: f64| per.entry(name.to_string()).or_default().push((n, t));
+        push(
+            "energy",
+            per_call(|| {
+                energy.energy(&state);
+            }),
+        );
+        push(
+            "gradient",
+            per_call(|| {
+                energy.gradient(&state, &mut g);
+            }),
+        );
+        push(
+            "hessian",
+            per_call(|| {
+                energy.hessian(&state, &mut g, &mut v);
+            }),
+        );
+        push(
+            "factorization",
+            per_call(|| {
+                ldlt.factor(&v).unwrap();
+            }),
+        );
+        push(
+            "lowest_eigenvalues",
+            per_call(|| {
+                lowest_eigenvalues(&energy.pattern, &v, None, 4, &mut ldlt).unwrap();
+            }),
+        );
+        let (p, arc) = state.centreline();
+        let closed = ray_closure(&p, -nalgebra::Vector3::z(), nalgebra::Vector3::z(), 1e6);
+        push(
+            "writhe",
+            per_call(|| {
+                writhe_closed(&closed);
+            }),
+        );
+        let short = ray_closure(&p, -nalgebra::Vector3::z(), nalgebra::Vector3::z(), 3.0);
+        push(
+            "knot_type",
+            per_call(|| {
+                knot_type(&short);
+            }),
+        );
+        push(
+            "self_distance",
+            per_call(|| {
+                min_self_distance(&p, &arc, 0.05);
+            }),
+        );
+        let m = Measure::of(&d);
+        push(
+            "diagnostics",
+            per_call(|| {
+                Shape::of(&state, &m);
+            }),
+        );
+    }
+    let exponents = per
+        .iter()
+        .map(|(k, v)| {
+            let (n0, t0) = v.first().copied().unwrap();
+            let (n1, t1) = v.last().copied().unwrap();
+            (k.clone(), (t1 / t0).ln() / (n1 as f64 / n0 as f64).ln())
+        })
+        .collect();
+    Ok(Report {
+        workloads,
+        exponents,
+        per_call: per,
+    })
+}
+
+/// Print a report as tables.
+pub fn print(r: &Report, out: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "| workload | N | seconds | Newton iterations | factorisations | peak memory (MB) |"
+    )?;
+    writeln!(out, "|---|---|---|---|---|---|")?;
+    for w in &r.workloads {
+        writeln!(
+            out,
+            "| {} | {} | {:.3} | {} | {} | {:.1} |",
+            w.name,
+            w.segments,
+            w.seconds,
+            w.newton_iterations,
+            w.factorizations,
+            w.peak_bytes as f64 / 1e6
+        )?;
+    }
+    writeln!(
+        out,
+        "\n| operation | N = 200 | 400 | 800 | 1600 | 3200 | exponent (200→3200) |"
+    )?;
+    writeln!(out, "|---|---|---|---|---|---|---|")?;
+    for (k, v) in &r.per_call {
+        let cells: Vec<String> = v.iter().map(|(_, t)| format!("{:.3e} s", t)).collect();
+        writeln!(
+            out,
+            "| {k} | {} | {:.2} |",
+            cells.join(" | "),
+            r.exponents[k]
+        )?;
+    }
+    Ok(())
+}
