@@ -10,12 +10,12 @@ use crate::stability::lowest_eigenvalues;
 use anyhow::{Result, ensure};
 use std::f64::consts::PI;
 
-/// Equilibrium reached from the straight (uniformly twisted) rod for `clamps`,
+/// The straight (uniformly twisted) equilibrium for `clamps`, stable or not,
 /// with its count of negative Hessian eigenvalues.
 pub fn straight_equilibrium(newton: &mut Newton, clamps: Clamps) -> Result<(RodState, usize)> {
     let n = newton.energy.model.segments;
     let mut st = RodState::straight(n, clamps);
-    newton.minimize(&mut st, &NewtonSettings::default())?;
+    newton.find_equilibrium(&mut st, &NewtonSettings::default())?;
     let mut g = vec![0.0; newton.energy.map.len()];
     let mut v = vec![0.0; newton.energy.pattern.nnz()];
     newton.energy.hessian(&st, &mut g, &mut v);

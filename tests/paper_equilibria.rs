@@ -76,3 +76,20 @@ fn appendix_d_converges_at_second_order() {
         "observed order {order} from Tw {tw:?}"
     );
 }
+
+#[test]
+fn newton_converges_quadratically_from_the_shooting_start() {
+    let scene = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
+    let e = solve_scene(&scene, Some(200)).unwrap();
+    let r = &e.residual_history;
+    assert!(e.iterations <= 6, "{} iterations: {r:?}", e.iterations);
+    // once in the quadratic regime each residual is about the square of the last
+    let mut checked = 0;
+    for w in r.windows(2) {
+        if w[0] < 1e-3 && w[1] > 1e-12 {
+            assert!(w[1] < 100.0 * w[0] * w[0], "not quadratic: {r:?}");
+            checked += 1;
+        }
+    }
+    assert!(checked >= 2, "too few steps in the quadratic regime: {r:?}");
+}

@@ -51,13 +51,15 @@ pub struct NewtonReport {
 pub enum SolveError {
     /// No convergence within the iteration budget.
     #[error(
-        "Newton did not converge in {iterations} iterations (relative gradient {residual:.3e})"
+        "Newton did not converge in {iterations} iterations (relative gradient {residual:.3e}; last ones {tail:?})"
     )]
     NotConverged {
         /// Iterations taken.
         iterations: usize,
         /// Final relative gradient.
         residual: f64,
+        /// The last few relative gradients.
+        tail: Vec<f64>,
     },
     /// A NaN or infinity appeared.
     #[error("non-finite value in {step} at Newton iteration {iteration}")]
@@ -106,6 +108,36 @@ impl Newton {
         }
     }
 
+    /// Replace the step by a small move (largest node move 1e-3) along the
+    /// lowest eigenvector of H when its eigenvalue is negative, downhill.
+    fn negative_curvature_step(&mut self, map: crate::model::rod::DofMap) {
+        let Ok(sp) = crate::stability::lowest_eigenvalues(
+            &self.energy.pattern,
+            &self.values,
+            None,
+            1,
+            &mut self.ldlt,
+        ) else {
+            return;
+        };
+        let (Some(&lambda), Some(v)) = (sp.values.first(), sp.vectors.first()) else {
+            return;
+        };
+        let largest = (0..v.len())
+            .filter(|&d| map.is_translation(d))
+            .map(|d| v[d].abs())
+            .fold(0.0, f64::max);
+        if lambda >= 0.0 || largest == 0.0 {
+            return;
+        }
+        let uphill: f64 = v.iter().zip(&self.grad).map(|(a, b)| a * b).sum();
+        let scale = if uphill > 0.0 { -1e-3 } else { 1e-3 } / largest;
+        self.step
+            .iter_mut()
+            .zip(v)
+            .for_each(|(s, x)| *s = scale * x);
+    }
+
     fn max_diagonal(&self) -> f64 {
         self.energy
             .pattern
@@ -113,6 +145,76 @@ impl Newton {
             .iter()
             .map(|&s| self.values[s].abs())
             .fold(0.0, f64::max)
+    }
+
+    /// Newton's method on ∇E = 0 from `state` without line search or shift:
+    /// converges to the nearby equilibrium whatever its stability (a saddle
+    /// too), where [`Self::minimize`] would leave a saddle.
+    pub fn find_equilibrium(
+        &mut self,
+        state: &mut RodState,
+        settings: &NewtonSettings,
+    ) -> Result<NewtonReport, SolveError> {
+        let mut report = NewtonReport {
+            converged: false,
+            iterations: 0,
+            residual_history: Vec::new(),
+            gradient_norm: f64::NAN,
+            energy: f64::NAN,
+            factorizations: 0,
+        };
+        let map = self.energy.map;
+        let mut next = state.clone();
+        for it in 0..=settings.max_iterations {
+            crate::solve::counters::NEWTON_ITERATIONS
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let info = self.energy.hessian(state, &mut self.grad, &mut self.values);
+            let gnorm = norm(&self.grad);
+            if !gnorm.is_finite() {
+                return Err(SolveError::NonFinite {
+                    step: "gradient",
+                    iteration: it,
+                });
+            }
+            let rel = if info.force_scale > 1e-300 {
+                gnorm / info.force_scale
+            } else {
+                0.0
+            };
+            report.residual_history.push(rel);
+            report.gradient_norm = rel;
+            report.energy = info.energy;
+            report.iterations = it;
+            let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
+            let floor = 16.0
+                * f64::EPSILON
+                * self.max_diagonal()
+                * extent.max(1e-3)
+                * (self.grad.len() as f64).sqrt();
+            if rel <= settings.gradient_tol || gnorm <= floor {
+                report.converged = true;
+                return Ok(report);
+            }
+            report.factorizations += 1;
+            if self.ldlt.factor(&self.values).is_err() {
+                return Err(SolveError::NonFinite {
+                    step: "singular Hessian",
+                    iteration: it,
+                });
+            }
+            for (s, g) in self.step.iter_mut().zip(&self.grad) {
+                *s = -g;
+            }
+            self.ldlt.solve_in_place(&mut self.step);
+            state.displace_into(&map, &self.step, &mut next);
+            std::mem::swap(state, &mut next);
+        }
+        let h = &report.residual_history;
+        Err(SolveError::NotConverged {
+            iterations: report.iterations,
+            residual: report.gradient_norm,
+            tail: h[h.len().saturating_sub(6)..].to_vec(),
+        })
     }
 
     /// Minimise the energy from `state` (updated in place).
@@ -130,6 +232,7 @@ impl Newton {
             factorizations: 0,
         };
         let mut shift = 0.0f64;
+        let mut next_shift = 0.0f64;
         let mut trial = state.clone();
         for it in 0..=settings.max_iterations {
             crate::solve::counters::NEWTON_ITERATIONS
@@ -169,10 +272,11 @@ impl Newton {
             // Newton direction with the smallest diagonal shift that makes the
             // Hessian positive definite (a descent direction for minimisation).
             let diag_scale = self.max_diagonal().max(1e-300);
-            shift = (shift * 0.1).max(0.0);
-            if shift < 1e-12 * diag_scale {
-                shift = 0.0;
-            }
+            // Levenberg-style: after a full step try the pure Newton step
+            // (quadratic convergence near a minimum), after a cut step a
+            // larger shift; raise it until H + shift is positive definite
+            let previous = shift;
+            shift = next_shift;
             loop {
                 for &s in &self.energy.pattern.diagonal {
                     self.values[s] += shift;
@@ -186,7 +290,7 @@ impl Newton {
                     break;
                 }
                 shift = if shift == 0.0 {
-                    1e-8 * diag_scale
+                    (0.1 * previous).max(1e-8 * diag_scale)
                 } else {
                     shift * 10.0
                 };
@@ -207,8 +311,13 @@ impl Newton {
                     iteration: it,
                 });
             }
-            // cap the largest node move
             let map = self.energy.map;
+            // near a saddle (small gradient, H indefinite) a shifted Newton step
+            // creeps: step off along the direction of negative curvature instead
+            if shift > 0.0 && rel < 1e-6 {
+                self.negative_curvature_step(map);
+            }
+            // cap the largest node move
             let largest = (0..self.step.len())
                 .filter(|&d| map.is_translation(d))
                 .map(|d| self.step[d].abs())
@@ -240,11 +349,21 @@ impl Newton {
                     residual: rel,
                 });
             }
+            // a full step keeps the pure Newton method; a cut step (a poor
+            // quadratic model: near-singular H, far from equilibrium) damps
+            // the next one
+            next_shift = if alpha >= 0.5 {
+                0.0
+            } else {
+                (10.0 * shift).max(1e-8 * diag_scale)
+            };
             std::mem::swap(state, &mut trial);
         }
+        let h = &report.residual_history;
         Err(SolveError::NotConverged {
             iterations: report.iterations,
             residual: report.gradient_norm,
+            tail: h[h.len().saturating_sub(6)..].to_vec(),
         })
     }
 }
