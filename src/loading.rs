@@ -13,9 +13,10 @@ use crate::stability::lowest_eigenvalues;
 use anyhow::{Context, Result, bail};
 
 /// A step is a jump when the minimiser lands farther than this (rod lengths)
-/// from the first-order prediction (and than half the predicted move)…
+/// from the first-order prediction (and than half the predicted move).
 pub const JUMP_DISPLACEMENT: f64 = 0.02;
-/// …or the link changes by more than this.
+/// A link change beyond this (other than the clamp's own turn) is a crossing
+/// of the centreline through itself.
 pub const JUMP_LINK: f64 = 0.5;
 
 /// Negative eigenvalue count and lowest mode of the Hessian at `state`.
@@ -156,9 +157,12 @@ pub fn run_loading(
             let miss = max_move(&state, &predicted);
             let dlink =
                 next.link - eq.link - (c.phi - eq_clamps(&eq).phi) / (2.0 * std::f64::consts::PI);
-            if miss > (0.5 * predicted_move).max(JUMP_DISPLACEMENT) || dlink.abs() > JUMP_LINK {
+            let jumped = miss > (0.5 * predicted_move).max(JUMP_DISPLACEMENT);
+            if jumped || dlink.abs() > JUMP_LINK {
                 events.push(Event {
-                    kind: "jump".into(),
+                    // the link changes by ±2 without a jump when the
+                    // centreline passes through itself (no contact model)
+                    kind: if jumped { "jump" } else { "crossing" }.into(),
                     label: String::new(),
                     phi_over_2pi: c.phi_over_2pi(),
                     z_star: c.z_star,
