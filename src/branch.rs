@@ -207,7 +207,13 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 break;
             }
             let b = match self.tracer.correct(&a, ds, None) {
-                Ok(b) if b.iterations <= 6 && self.tracer_dot(&a, &b) > 0.9 => b,
+                // few corrector iterations, a small correction and a small
+                // turn of the tangent: the step stayed on this part of the branch
+                Ok(b)
+                    if b.iterations <= 6 && b.correction < 0.5 && self.tracer_dot(&a, &b) > 0.9 =>
+                {
+                    b
+                }
                 _ => {
                     ds *= 0.5;
                     if ds < settings.min_step {
@@ -268,7 +274,17 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 "negative eigenvalues {} → {}",
                 a.negative_count, b.negative_count
             );
-            self.events.push(event("fold", &p, branch, detail));
+            if a.negative_count == b.negative_count {
+                // φ extremal while no eigenvalue changes sign: an eigenvalue
+                // touches zero where an asymmetric branch meets the symmetric
+                // one, and the path goes on along the mirror image (same
+                // φ, Tw, walls): a symmetric branch point, not a fold
+                let detail =
+                    format!("{detail}; through a symmetric branch point onto the mirror branch");
+                self.events.push(event("branch_point", &p, branch, detail));
+            } else {
+                self.events.push(event("fold", &p, branch, detail));
+            }
         }
         if a.negative_count != b.negative_count {
             let na = a.negative_count;

@@ -57,6 +57,10 @@ pub struct Point {
     pub iterations: usize,
     /// Relative gradient at convergence.
     pub residual: f64,
+    /// How far the corrector moved from the predictor, relative to the step
+    /// (weighted norm): large when it had to jump to another part of the
+    /// branch, e.g. across a hairpin.
+    pub correction: f64,
 }
 
 /// Why a continuation step failed.
@@ -189,6 +193,7 @@ impl<'a> Tracer<'a> {
             negative_count,
             iterations: 0,
             residual,
+            correction: 0.0,
         })
     }
 
@@ -228,6 +233,8 @@ impl<'a> Tracer<'a> {
                     negative_count,
                     iterations: it,
                     residual: rel,
+                    correction: (self.weight * dot(&offset, &offset) + (p - p_pred).powi(2)).sqrt()
+                        / sigma.abs().max(1e-300),
                 });
             }
             if it == self.settings.max_corrector_iterations {
