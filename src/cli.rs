@@ -520,16 +520,7 @@ fn write_map(map: &crate::map::Map, json: &Path) -> Result<()> {
         writeln!(out, "  good knots for {k} in [{:.5}, {:.5}]", v[0], v[1])?;
     }
     for l in &map.lines {
-        let iv: Vec<String> = l
-            .intervals
-            .iter()
-            .map(|i| {
-                format!(
-                    "[{:.4} ({}), {:.4} ({})]",
-                    i.lo, i.lo_label, i.hi, i.hi_label
-                )
-            })
-            .collect();
+        let iv: Vec<String> = l.intervals.iter().map(|i| i.to_string()).collect();
         writeln!(
             out,
             "  {} = {:.4}: {}{}",

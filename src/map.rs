@@ -11,7 +11,6 @@ use crate::equilibrium::{Equilibrium, Measure, starting_equilibrium};
 use crate::model::rod::Parameter;
 use crate::run::reach;
 use crate::scene::Scene;
-use crate::solve::continuation::ContinuationSettings;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -66,6 +65,16 @@ pub struct Interval {
     pub lo_label: String,
     /// Boundary label at the upper end (W2, X, S, range, ...).
     pub hi_label: String,
+}
+
+impl std::fmt::Display for Interval {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "[{:.4} ({}), {:.4} ({})]",
+            self.lo, self.lo_label, self.hi, self.hi_label
+        )
+    }
 }
 
 /// One line of the map: the branch in φ at one value of the swept parameter.
@@ -280,13 +289,7 @@ fn compute_line(
         .as_ref()
         .context("[map] needs a [continuation] in φ")?;
     let (mut newton, state, _) = starting_equilibrium(scene, segments)?;
-    let defaults = ContinuationSettings::default();
-    let settings = ContinuationSettings {
-        step: c.step.unwrap_or(defaults.step),
-        max_step: c.max_step.unwrap_or(defaults.max_step),
-        max_points: c.max_points.map_or(defaults.max_points, |m| m as usize),
-        ..defaults
-    };
+    let settings = c.settings();
     let state = reach(&mut newton, state, spec.parameter, value, &settings)?;
     let options = BranchOptions {
         parameter: c.parameter,

@@ -101,13 +101,7 @@ pub fn run_scene(
         observer(analyse(&mut newton, &state, &report, &measure)?)?;
         return Ok(vec![]);
     };
-    let defaults = ContinuationSettings::default();
-    let settings = ContinuationSettings {
-        step: spec.step.unwrap_or(defaults.step),
-        max_step: spec.max_step.unwrap_or(defaults.max_step),
-        max_points: spec.max_points.map_or(defaults.max_points, |m| m as usize),
-        ..defaults
-    };
+    let settings = spec.settings();
     let options = BranchOptions {
         parameter: spec.parameter,
         range: spec.range,

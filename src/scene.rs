@@ -195,6 +195,19 @@ pub struct ContinuationSpec {
     pub max_points: Option<i64>,
 }
 
+impl ContinuationSpec {
+    /// The numerical continuation settings this spec asks for.
+    pub fn settings(&self) -> crate::solve::continuation::ContinuationSettings {
+        let defaults = crate::solve::continuation::ContinuationSettings::default();
+        crate::solve::continuation::ContinuationSettings {
+            step: self.step.unwrap_or(defaults.step),
+            max_step: self.max_step.unwrap_or(defaults.max_step),
+            max_points: self.max_points.map_or(defaults.max_points, |m| m as usize),
+            ..defaults
+        }
+    }
+}
+
 fn yes() -> bool {
     true
 }

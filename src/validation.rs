@@ -455,16 +455,7 @@ fn island_table(scenes: &Path) -> Result<String> {
     )?;
     writeln!(s, "|---|---|")?;
     for l in &map.lines {
-        let iv: Vec<String> = l
-            .intervals
-            .iter()
-            .map(|i| {
-                format!(
-                    "[{:.4} ({}), {:.4} ({})]",
-                    i.lo, i.lo_label, i.hi, i.hi_label
-                )
-            })
-            .collect();
+        let iv: Vec<String> = l.intervals.iter().map(|i| i.to_string()).collect();
         if !iv.is_empty() || l.error.is_some() {
             writeln!(
                 s,

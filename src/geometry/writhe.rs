@@ -5,48 +5,6 @@
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 
-/// Signed solid-angle contribution Ω/(4π) of the segment pair (p1→p2, p3→p4) to
-/// the Gauss double integral (counted once; the writhe sums it over ordered
-/// pairs i ≠ j, i.e. twice over unordered pairs).
-pub fn segment_pair_writhe(
-    p1: &Vector3<f64>,
-    p2: &Vector3<f64>,
-    p3: &Vector3<f64>,
-    p4: &Vector3<f64>,
-) -> f64 {
-    let r13 = p3 - p1;
-    let r14 = p4 - p1;
-    let r23 = p3 - p2;
-    let r24 = p4 - p2;
-    let unit = |v: Vector3<f64>| {
-        let n = v.norm();
-        if n > 0.0 { Some(v / n) } else { None }
-    };
-    let (Some(n1), Some(n2), Some(n3), Some(n4)) = (
-        unit(r13.cross(&r14)),
-        unit(r14.cross(&r24)),
-        unit(r24.cross(&r23)),
-        unit(r23.cross(&r13)),
-    ) else {
-        // a degenerate quadrilateral (coplanar or touching): no solid angle
-        return 0.0;
-    };
-    // asin via atan2: accurate near ±1 and free of libm slow paths
-    let asin = |x: f64| {
-        let x = x.clamp(-1.0, 1.0);
-        x.atan2(((1.0 - x) * (1.0 + x)).sqrt())
-    };
-    let omega = asin(n1.dot(&n2)) + asin(n2.dot(&n3)) + asin(n3.dot(&n4)) + asin(n4.dot(&n1));
-    let sign = (p4 - p3).cross(&(p2 - p1)).dot(&r13);
-    if sign > 0.0 {
-        omega / (4.0 * PI)
-    } else if sign < 0.0 {
-        -omega / (4.0 * PI)
-    } else {
-        0.0
-    }
-}
-
 /// Signed solid angle of the triangle (a, b, c) seen from the origin
 /// (Van Oosterom & Strackee, IEEE Trans. Biomed. Eng. 30 (1983) 125).
 fn triangle_solid_angle(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) -> f64 {
@@ -56,10 +14,13 @@ fn triangle_solid_angle(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) ->
     2.0 * num.atan2(den)
 }
 
-/// The same contribution as [`segment_pair_writhe`], from the solid angle of
-/// the parallelogram {x_j − x_i} split into two triangles: two `atan2` instead
-/// of four normalisations and four `asin`.
-pub fn segment_pair_writhe_fast(
+/// Signed contribution Ω/(4π) of the segment pair (p1→p2, p3→p4) to the Gauss
+/// double integral (counted once; the writhe sums it over ordered pairs i ≠ j):
+/// the solid angle of the parallelogram {x_j − x_i} seen from the origin, split
+/// into two triangles — two `atan2`, cheaper than Klenin & Langowski's four
+/// normalisations and four `asin` (Biopolymers 54 (2000) 307), which the tests
+/// keep as a reference.
+pub fn segment_pair_writhe(
     p1: &Vector3<f64>,
     p2: &Vector3<f64>,
     p3: &Vector3<f64>,
@@ -88,7 +49,7 @@ pub fn writhe_closed(points: &[Vector3<f64>]) -> f64 {
                 continue;
             }
             let (c, d) = seg(j);
-            total += segment_pair_writhe_fast(a, b, c, d);
+            total += segment_pair_writhe(a, b, c, d);
         }
     }
     2.0 * total
@@ -97,6 +58,48 @@ pub fn writhe_closed(points: &[Vector3<f64>]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Reference: Klenin & Langowski's formula. Signed solid-angle contribution Ω/(4π) of the segment pair (p1→p2, p3→p4) to
+    /// the Gauss double integral (counted once; the writhe sums it over ordered
+    /// pairs i ≠ j, i.e. twice over unordered pairs).
+    fn klenin_langowski(
+        p1: &Vector3<f64>,
+        p2: &Vector3<f64>,
+        p3: &Vector3<f64>,
+        p4: &Vector3<f64>,
+    ) -> f64 {
+        let r13 = p3 - p1;
+        let r14 = p4 - p1;
+        let r23 = p3 - p2;
+        let r24 = p4 - p2;
+        let unit = |v: Vector3<f64>| {
+            let n = v.norm();
+            if n > 0.0 { Some(v / n) } else { None }
+        };
+        let (Some(n1), Some(n2), Some(n3), Some(n4)) = (
+            unit(r13.cross(&r14)),
+            unit(r14.cross(&r24)),
+            unit(r24.cross(&r23)),
+            unit(r23.cross(&r13)),
+        ) else {
+            // a degenerate quadrilateral (coplanar or touching): no solid angle
+            return 0.0;
+        };
+        // asin via atan2: accurate near ±1 and free of libm slow paths
+        let asin = |x: f64| {
+            let x = x.clamp(-1.0, 1.0);
+            x.atan2(((1.0 - x) * (1.0 + x)).sqrt())
+        };
+        let omega = asin(n1.dot(&n2)) + asin(n2.dot(&n3)) + asin(n3.dot(&n4)) + asin(n4.dot(&n1));
+        let sign = (p4 - p3).cross(&(p2 - p1)).dot(&r13);
+        if sign > 0.0 {
+            omega / (4.0 * PI)
+        } else if sign < 0.0 {
+            -omega / (4.0 * PI)
+        } else {
+            0.0
+        }
+    }
 
     #[test]
     fn both_segment_pair_formulas_agree() {
@@ -112,8 +115,8 @@ mod tests {
             let mut p = || Vector3::new(next(), next(), next());
             let (a, b, c, d) = (p(), p(), p(), p());
             let (u, v) = (
+                klenin_langowski(&a, &b, &c, &d),
                 segment_pair_writhe(&a, &b, &c, &d),
-                segment_pair_writhe_fast(&a, &b, &c, &d),
             );
             worst = worst.max((u - v).abs());
         }

@@ -1,7 +1,7 @@
 //! Newton's method for equilibria of the discrete rod: energy minimisation with
 //! a line search and a diagonal shift for indefinite Hessians.
 
-use crate::model::energy::RodEnergy;
+use crate::model::energy::{GradientInfo, RodEnergy};
 use crate::model::rod::RodState;
 use crate::solve::sparse::Ldlt;
 use serde::{Deserialize, Serialize};
@@ -147,6 +147,38 @@ impl Newton {
             .fold(0.0, f64::max)
     }
 
+    /// Gradient and Hessian at `state` (into the workspace), the relative
+    /// gradient, and whether the gradient is at its round-off floor (ε ×
+    /// largest stiffness × extent × √n: no step can improve it below that).
+    fn linearise(
+        &mut self,
+        state: &RodState,
+        iteration: usize,
+    ) -> Result<(GradientInfo, f64, bool), SolveError> {
+        crate::solve::counters::NEWTON_ITERATIONS
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let info = self.energy.hessian(state, &mut self.grad, &mut self.values);
+        let gnorm = norm(&self.grad);
+        if !info.energy.is_finite() || !gnorm.is_finite() {
+            return Err(SolveError::NonFinite {
+                step: "energy/gradient evaluation",
+                iteration,
+            });
+        }
+        let rel = if info.force_scale > 1e-300 {
+            gnorm / info.force_scale
+        } else {
+            0.0
+        };
+        let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
+        let floor = 16.0
+            * f64::EPSILON
+            * self.max_diagonal()
+            * extent.max(1e-3)
+            * (self.grad.len() as f64).sqrt();
+        Ok((info, rel, gnorm <= floor))
+    }
+
     /// Newton's method on ∇E = 0 from `state` without line search or shift:
     /// converges to the nearby equilibrium whatever its stability (a saddle
     /// too), where [`Self::minimize`] would leave a saddle.
@@ -166,32 +198,12 @@ impl Newton {
         let map = self.energy.map;
         let mut next = state.clone();
         for it in 0..=settings.max_iterations {
-            crate::solve::counters::NEWTON_ITERATIONS
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let info = self.energy.hessian(state, &mut self.grad, &mut self.values);
-            let gnorm = norm(&self.grad);
-            if !gnorm.is_finite() {
-                return Err(SolveError::NonFinite {
-                    step: "gradient",
-                    iteration: it,
-                });
-            }
-            let rel = if info.force_scale > 1e-300 {
-                gnorm / info.force_scale
-            } else {
-                0.0
-            };
+            let (info, rel, at_floor) = self.linearise(state, it)?;
             report.residual_history.push(rel);
             report.gradient_norm = rel;
             report.energy = info.energy;
             report.iterations = it;
-            let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
-            let floor = 16.0
-                * f64::EPSILON
-                * self.max_diagonal()
-                * extent.max(1e-3)
-                * (self.grad.len() as f64).sqrt();
-            if rel <= settings.gradient_tol || gnorm <= floor {
+            if rel <= settings.gradient_tol || at_floor {
                 report.converged = true;
                 return Ok(report);
             }
@@ -235,34 +247,12 @@ impl Newton {
         let mut next_shift = 0.0f64;
         let mut trial = state.clone();
         for it in 0..=settings.max_iterations {
-            crate::solve::counters::NEWTON_ITERATIONS
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let info = self.energy.hessian(state, &mut self.grad, &mut self.values);
-            let gnorm = norm(&self.grad);
-            if !info.energy.is_finite() || !gnorm.is_finite() {
-                return Err(SolveError::NonFinite {
-                    step: "energy/gradient evaluation",
-                    iteration: it,
-                });
-            }
-            let rel = if info.force_scale > 1e-300 {
-                gnorm / info.force_scale
-            } else {
-                0.0
-            };
+            let (info, rel, at_floor) = self.linearise(state, it)?;
             report.residual_history.push(rel);
             report.gradient_norm = rel;
             report.energy = info.energy;
             report.iterations = it;
-            // the gradient is known only to round-off of the positions times the
-            // stiffness: below that floor no step can improve it
-            let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
-            let floor = 16.0
-                * f64::EPSILON
-                * self.max_diagonal()
-                * extent.max(1e-3)
-                * (self.grad.len() as f64).sqrt();
-            if rel <= settings.gradient_tol || gnorm <= floor {
+            if rel <= settings.gradient_tol || at_floor {
                 report.converged = true;
                 return Ok(report);
             }
