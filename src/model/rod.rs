@@ -270,10 +270,21 @@ impl RodState {
 
     /// As [`Self::displaced`], writing into `next` (which must have this state's shape).
     pub fn displace_into(&self, map: &DofMap, dq: &[f64], next: &mut RodState) {
+        self.move_into(map, dq, self.clamps, next);
+    }
+
+    /// Move the free dofs by `dq` and the s = 1 clamp to `clamps` in one step,
+    /// writing into `next` (same shape): one transport of the frames, no
+    /// allocation.
+    pub fn move_into(&self, map: &DofMap, dq: &[f64], clamps: Clamps, next: &mut RodState) {
         let n = self.segments();
-        next.clamps = self.clamps;
+        next.clamps = clamps;
         next.nodes.copy_from_slice(&self.nodes);
         next.theta.copy_from_slice(&self.theta);
+        let shift = clamps.end_point() - self.clamps.end_point();
+        next.nodes[n] += shift;
+        next.nodes[n + 1] += shift;
+        next.theta[n] = clamps.phi;
         for i in 2..n {
             let d = map.node(i).unwrap();
             next.nodes[i] += Vector3::new(dq[d], dq[d + 1], dq[d + 2]);

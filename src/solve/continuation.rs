@@ -5,7 +5,7 @@
 //! in arclength on a test function.
 
 use crate::model::rod::{Parameter, RodState};
-use crate::solve::newton::{Newton, SolveError};
+use crate::solve::newton::{Newton, SolveError, residual};
 use serde::{Deserialize, Serialize};
 
 /// Settings of one continuation.
@@ -139,25 +139,18 @@ impl<'a> Tracer<'a> {
         if !gnorm.is_finite() || self.values.iter().any(|v| !v.is_finite()) {
             return Err(ContinuationError::NonFinite("gradient/Hessian"));
         }
-        let rel = if info.force_scale > 1e-300 {
-            gnorm / info.force_scale
-        } else {
-            0.0
-        };
-        let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
         let max_diag = energy
             .pattern
             .diagonal
             .iter()
             .map(|&s| self.values[s].abs())
             .fold(0.0, f64::max);
-        let floor =
-            16.0 * f64::EPSILON * max_diag * extent.max(1e-3) * (self.grad.len() as f64).sqrt();
+        let (rel, at_floor) = residual(&info, gnorm, max_diag, state, self.grad.len());
         self.newton
             .ldlt
             .factor(&self.values)
             .map_err(|_| ContinuationError::Singular("linearisation"))?;
-        Ok((rel, gnorm <= floor))
+        Ok((rel, at_floor))
     }
 
     /// Tangent at a converged state (factorisation of `linearise` in place):
@@ -210,9 +203,16 @@ impl<'a> Tracer<'a> {
         let map = self.newton.energy.map;
         let p_pred = self.parameter_of(&from.state) + sigma * tp;
         let mut state = from.state.clone();
-        state.set_clamps(self.parameter.with(&state.clamps, p_pred));
-        let pred_step: Vec<f64> = tq.iter().map(|x| sigma * x).collect();
-        state = state.displaced(&map, &pred_step);
+        let mut next = from.state.clone();
+        for (a, t) in self.a.iter_mut().zip(&tq) {
+            *a = sigma * t;
+        }
+        from.state.move_into(
+            &map,
+            &self.a,
+            self.parameter.with(&from.state.clamps, p_pred),
+            &mut state,
+        );
         let mut offset = vec![0.0; tq.len()];
         let mut p = p_pred;
         for it in 0..=self.settings.max_corrector_iterations {
@@ -249,12 +249,11 @@ impl<'a> Tracer<'a> {
             if !dp.is_finite() {
                 return Err(ContinuationError::NonFinite("corrector"));
             }
-            let dq: Vec<f64> = self
-                .a
-                .iter()
-                .zip(&self.b)
-                .map(|(a, b)| -a - dp * b)
-                .collect();
+            // the step dq = -a - dp b, in place of a
+            for (a, b) in self.a.iter_mut().zip(&self.b) {
+                *a = -*a - dp * b;
+            }
+            let dq = &self.a;
             // a corrector that moves far is not converging to this branch
             let largest = (0..dq.len())
                 .filter(|&d| map.is_translation(d))
@@ -264,9 +263,9 @@ impl<'a> Tracer<'a> {
                 return Err(ContinuationError::Corrector(it + 1));
             }
             p += dp;
-            state.set_clamps(self.parameter.with(&state.clamps, p));
-            state = state.displaced(&map, &dq);
-            offset.iter_mut().zip(&dq).for_each(|(o, d)| *o += d);
+            state.move_into(&map, dq, self.parameter.with(&state.clamps, p), &mut next);
+            std::mem::swap(&mut state, &mut next);
+            offset.iter_mut().zip(dq).for_each(|(o, d)| *o += d);
         }
         Err(ContinuationError::Corrector(
             self.settings.max_corrector_iterations,

@@ -46,6 +46,35 @@ pub struct NewtonReport {
     pub factorizations: usize,
 }
 
+impl NewtonReport {
+    fn start() -> Self {
+        NewtonReport {
+            converged: false,
+            iterations: 0,
+            residual_history: Vec::new(),
+            gradient_norm: f64::NAN,
+            energy: f64::NAN,
+            factorizations: 0,
+        }
+    }
+
+    fn record(&mut self, iteration: usize, rel: f64, energy: f64) {
+        self.residual_history.push(rel);
+        self.gradient_norm = rel;
+        self.energy = energy;
+        self.iterations = iteration;
+    }
+
+    fn not_converged(&self) -> SolveError {
+        let h = &self.residual_history;
+        SolveError::NotConverged {
+            iterations: self.iterations,
+            residual: self.gradient_norm,
+            tail: h[h.len().saturating_sub(6)..].to_vec(),
+        }
+    }
+}
+
 /// Why a solve failed.
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
@@ -91,6 +120,7 @@ pub struct Newton {
     grad: Vec<f64>,
     values: Vec<f64>,
     step: Vec<f64>,
+    trial_step: Vec<f64>,
 }
 
 impl Newton {
@@ -105,6 +135,7 @@ impl Newton {
             grad: vec![0.0; n],
             values: vec![0.0; nnz],
             step: vec![0.0; n],
+            trial_step: vec![0.0; n],
         }
     }
 
@@ -165,18 +196,8 @@ impl Newton {
                 iteration,
             });
         }
-        let rel = if info.force_scale > 1e-300 {
-            gnorm / info.force_scale
-        } else {
-            0.0
-        };
-        let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
-        let floor = 16.0
-            * f64::EPSILON
-            * self.max_diagonal()
-            * extent.max(1e-3)
-            * (self.grad.len() as f64).sqrt();
-        Ok((info, rel, gnorm <= floor))
+        let (rel, at_floor) = residual(&info, gnorm, self.max_diagonal(), state, self.grad.len());
+        Ok((info, rel, at_floor))
     }
 
     /// Newton's method on ∇E = 0 from `state` without line search or shift:
@@ -187,22 +208,12 @@ impl Newton {
         state: &mut RodState,
         settings: &NewtonSettings,
     ) -> Result<NewtonReport, SolveError> {
-        let mut report = NewtonReport {
-            converged: false,
-            iterations: 0,
-            residual_history: Vec::new(),
-            gradient_norm: f64::NAN,
-            energy: f64::NAN,
-            factorizations: 0,
-        };
+        let mut report = NewtonReport::start();
         let map = self.energy.map;
         let mut next = state.clone();
         for it in 0..=settings.max_iterations {
             let (info, rel, at_floor) = self.linearise(state, it)?;
-            report.residual_history.push(rel);
-            report.gradient_norm = rel;
-            report.energy = info.energy;
-            report.iterations = it;
+            report.record(it, rel, info.energy);
             if rel <= settings.gradient_tol || at_floor {
                 report.converged = true;
                 return Ok(report);
@@ -221,12 +232,7 @@ impl Newton {
             state.displace_into(&map, &self.step, &mut next);
             std::mem::swap(state, &mut next);
         }
-        let h = &report.residual_history;
-        Err(SolveError::NotConverged {
-            iterations: report.iterations,
-            residual: report.gradient_norm,
-            tail: h[h.len().saturating_sub(6)..].to_vec(),
-        })
+        Err(report.not_converged())
     }
 
     /// Minimise the energy from `state` (updated in place).
@@ -235,23 +241,13 @@ impl Newton {
         state: &mut RodState,
         settings: &NewtonSettings,
     ) -> Result<NewtonReport, SolveError> {
-        let mut report = NewtonReport {
-            converged: false,
-            iterations: 0,
-            residual_history: Vec::new(),
-            gradient_norm: f64::NAN,
-            energy: f64::NAN,
-            factorizations: 0,
-        };
+        let mut report = NewtonReport::start();
         let mut shift = 0.0f64;
         let mut next_shift = 0.0f64;
         let mut trial = state.clone();
         for it in 0..=settings.max_iterations {
             let (info, rel, at_floor) = self.linearise(state, it)?;
-            report.residual_history.push(rel);
-            report.gradient_norm = rel;
-            report.energy = info.energy;
-            report.iterations = it;
+            report.record(it, rel, info.energy);
             if rel <= settings.gradient_tol || at_floor {
                 report.converged = true;
                 return Ok(report);
@@ -321,8 +317,10 @@ impl Newton {
             let mut alpha = 1.0;
             let mut accepted = false;
             for _ in 0..40 {
-                let scaled: Vec<f64> = self.step.iter().map(|v| alpha * v).collect();
-                state.displace_into(&map, &scaled, &mut trial);
+                for (t, v) in self.trial_step.iter_mut().zip(&self.step) {
+                    *t = alpha * v;
+                }
+                state.displace_into(&map, &self.trial_step, &mut trial);
                 let e = self.energy.energy(&trial);
                 // near convergence the energy decrease is below round-off: accept
                 // a full step whose energy is equal to working precision
@@ -349,13 +347,29 @@ impl Newton {
             };
             std::mem::swap(state, &mut trial);
         }
-        let h = &report.residual_history;
-        Err(SolveError::NotConverged {
-            iterations: report.iterations,
-            residual: report.gradient_norm,
-            tail: h[h.len().saturating_sub(6)..].to_vec(),
-        })
+        Err(report.not_converged())
     }
+}
+
+/// Relative gradient (against the scale of the internal forces) and whether
+/// the gradient is at its round-off floor, ε × largest stiffness × extent × √n:
+/// below it no step can improve it. Shared by Newton and the continuation
+/// corrector.
+pub fn residual(
+    info: &GradientInfo,
+    gnorm: f64,
+    max_diagonal: f64,
+    state: &RodState,
+    dofs: usize,
+) -> (f64, bool) {
+    let rel = if info.force_scale > 1e-300 {
+        gnorm / info.force_scale
+    } else {
+        0.0
+    };
+    let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
+    let floor = 16.0 * f64::EPSILON * max_diagonal * extent.max(1e-3) * (dofs as f64).sqrt();
+    (rel, gnorm <= floor)
 }
 
 fn norm(v: &[f64]) -> f64 {
