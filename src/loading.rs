@@ -114,6 +114,62 @@ fn predict(newton: &mut Newton, state: &RodState, c: Clamps) -> Result<RodState>
     }
 }
 
+/// Jumps are located along the path to this (clamp-parameter units: z*, δ in
+/// rod lengths, φ in turns).
+pub const JUMP_LOCATION: f64 = 1e-4;
+
+/// One quasi-static step: the settled state, and whether it jumped.
+struct Step {
+    state: RodState,
+    report: crate::solve::newton::NewtonReport,
+    /// Distance from the first-order prediction.
+    miss: f64,
+    jumped: bool,
+}
+
+/// Move the clamps of the equilibrium `state` to `c` and settle: first-order
+/// prediction along the branch (dq = −H⁻¹ ∂_p∇E), then minimisation. A smooth
+/// branch lands within second order of the prediction; a jump lands far away.
+fn carry(
+    newton: &mut Newton,
+    state: &RodState,
+    c: Clamps,
+    settings: &NewtonSettings,
+) -> Result<Step> {
+    let predicted = predict(newton, state, c)?;
+    let predicted_move = max_move(&predicted, state);
+    let mut next = predicted.clone();
+    let report = settle(newton, &mut next, settings)?;
+    let miss = max_move(&next, &predicted);
+    Ok(Step {
+        state: next,
+        report,
+        miss,
+        jumped: miss > (0.5 * predicted_move).max(JUMP_DISPLACEMENT),
+    })
+}
+
+/// Link change between two equilibria beyond the clamp's own turn.
+fn link_jump(a: &crate::equilibrium::Equilibrium, b: &crate::equilibrium::Equilibrium) -> f64 {
+    b.link - a.link - (eq_clamps(b).phi - eq_clamps(a).phi) / (2.0 * std::f64::consts::PI)
+}
+
+/// Largest clamp-parameter difference (φ in turns).
+fn clamp_gap(a: &Clamps, b: &Clamps) -> f64 {
+    (a.z_star - b.z_star)
+        .abs()
+        .max((a.delta - b.delta).abs())
+        .max((a.phi_over_2pi() - b.phi_over_2pi()).abs())
+}
+
+fn midpoint(a: &Clamps, b: &Clamps) -> Clamps {
+    Clamps {
+        z_star: 0.5 * (a.z_star + b.z_star),
+        delta: 0.5 * (a.delta + b.delta),
+        phi: 0.5 * (a.phi + b.phi),
+    }
+}
+
 /// Run the loading path from `state` (an equilibrium at its clamps): every
 /// equilibrium goes to `observer`; returns the jumps.
 pub fn run_loading(
@@ -145,38 +201,51 @@ pub fn run_loading(
                 delta: c0.delta + f * (target.delta - c0.delta),
                 phi: c0.phi + f * (target.phi - c0.phi),
             };
-            // first-order prediction along the branch: dq = −H⁻¹ ∂_p∇E
-            let predicted = predict(newton, &state, c)?;
-            let predicted_move = max_move(&predicted, &state);
-            state = predicted.clone();
-            let report = settle(newton, &mut state, settings)
-                .with_context(|| format!("loading leg {leg}, step {k}"))?;
-            let next = analyse(newton, &state, &report, measure)?;
-            // a smooth branch lands within second order of the prediction; a
-            // jump lands far away, or changes the link by a crossing
-            let miss = max_move(&state, &predicted);
-            let dlink =
-                next.link - eq.link - (c.phi - eq_clamps(&eq).phi) / (2.0 * std::f64::consts::PI);
-            let jumped = miss > (0.5 * predicted_move).max(JUMP_DISPLACEMENT);
-            if jumped || dlink.abs() > JUMP_LINK {
-                events.push(Event {
-                    // the link changes by ±2 without a jump when the
-                    // centreline passes through itself (no contact model)
-                    kind: if jumped { "jump" } else { "crossing" }.into(),
-                    label: String::new(),
-                    phi_over_2pi: c.phi_over_2pi(),
-                    z_star: c.z_star,
-                    delta: c.delta,
-                    twist: eq.twist,
-                    // for a loading path, the leg of the path
-                    branch: leg,
-                    detail: format!(
-                        "lands {miss:.4} from the prediction, link {:.3} → {:.3}, twist {:.3} → {:.3}",
-                        eq.link, next.link, eq.twist, next.twist
-                    ),
-                });
+            let context = || format!("loading leg {leg}, step {k}");
+            let mut step = carry(newton, &state, c, settings).with_context(context)?;
+            let mut next = analyse(newton, &step.state, &step.report, measure)?;
+            if step.jumped || link_jump(&eq, &next).abs() > JUMP_LINK {
+                // a hand moves slowly: the rod jumps where its branch ends, not
+                // where a finite step happened to overshoot; bisect the step
+                let (mut lo_state, mut lo_eq, mut hi) = (state.clone(), eq.clone(), c);
+                while clamp_gap(&lo_state.clamps, &hi) > JUMP_LOCATION {
+                    let mid = midpoint(&lo_state.clamps, &hi);
+                    let trial = carry(newton, &lo_state, mid, settings).with_context(context)?;
+                    let trial_eq = analyse(newton, &trial.state, &trial.report, measure)?;
+                    if trial.jumped || link_jump(&lo_eq, &trial_eq).abs() > JUMP_LINK {
+                        hi = mid;
+                    } else {
+                        (lo_state, lo_eq) = (trial.state, trial_eq);
+                    }
+                }
+                // the last step from the end of the branch jumps; the rod then
+                // moves on from where it landed to this step's clamps
+                let landed = carry(newton, &lo_state, hi, settings).with_context(context)?;
+                let landed_eq = analyse(newton, &landed.state, &landed.report, measure)?;
+                let jump_link = link_jump(&lo_eq, &landed_eq);
+                if landed.jumped || jump_link.abs() > JUMP_LINK {
+                    events.push(Event {
+                        // the link changes by ±2 without a jump when the
+                        // centreline passes through itself (no contact model)
+                        kind: if landed.jumped { "jump" } else { "crossing" }.into(),
+                        label: String::new(),
+                        phi_over_2pi: hi.phi_over_2pi(),
+                        z_star: hi.z_star,
+                        delta: hi.delta,
+                        twist: lo_eq.twist,
+                        // for a loading path, the leg of the path
+                        branch: leg,
+                        detail: format!(
+                            "lands {:.4} from the prediction, link {:.3} → {:.3}, twist {:.3} → {:.3}",
+                            landed.miss, lo_eq.link, landed_eq.link, lo_eq.twist, landed_eq.twist
+                        ),
+                    });
+                    step = carry(newton, &landed.state, c, settings).with_context(context)?;
+                    next = analyse(newton, &step.state, &step.report, measure)?;
+                }
             }
             observer(next.clone())?;
+            state = step.state;
             eq = next;
         }
     }

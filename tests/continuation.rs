@@ -215,3 +215,63 @@ fn two_mirror_branches_leave_the_pitchfork() {
         assert!(d > 1e-3, "the two branches coincide");
     }
 }
+
+/// The buckled strip-like rod of scenes/loading_twist_snap.toml, its clamp
+/// turned up to 1.2 turns and back to 0.5 in `up` and `down` steps.
+fn twist_snap(up: usize, down: usize) -> (Vec<Equilibrium>, Vec<Event>) {
+    let text = std::fs::read_to_string("scenes/loading_twist_snap.toml").unwrap();
+    let text = text
+        .replace("steps = 60", &format!("steps = {up}"))
+        .replace("steps = 35", &format!("steps = {down}"));
+    let text = text.split("[output]").next().unwrap();
+    run(&Scene::parse(text).unwrap())
+}
+
+#[test]
+fn twisting_a_buckled_rod_snaps_at_two_different_angles() {
+    let (eqs, events) = twist_snap(60, 35);
+    assert_eq!(eqs.len(), 96);
+    for e in &eqs {
+        assert!(
+            e.converged && e.negative_eigenvalues == 0,
+            "not a converged minimum at φ/2π = {}",
+            e.phi_over_2pi
+        );
+    }
+    let jumps: Vec<&Event> = events.iter().filter(|e| e.kind == "jump").collect();
+    assert_eq!(jumps.len(), 2, "{events:?}");
+    let (up, down) = (jumps[0], jumps[1]);
+    assert_eq!((up.branch, down.branch), (0, 1), "one jump each way");
+    // the loop: it snaps forward near one turn and back well below that
+    assert!(
+        up.phi_over_2pi - down.phi_over_2pi > 0.1,
+        "{} vs {}",
+        up.phi_over_2pi,
+        down.phi_over_2pi
+    );
+    // between the two, the rod is in different states going up and down
+    let at = |leg: usize| {
+        let (up, down) = eqs.split_at(61);
+        [up, down][leg]
+            .iter()
+            .min_by(|a, b| {
+                (a.phi_over_2pi - 0.9)
+                    .abs()
+                    .total_cmp(&(b.phi_over_2pi - 0.9).abs())
+            })
+            .unwrap()
+    };
+    assert!((at(0).twist - at(1).twist).abs() > 0.1);
+    // jumps are located where the branch ends, not where a step overshoots
+    let (_, again) = twist_snap(47, 29);
+    let again: Vec<&Event> = again.iter().filter(|e| e.kind == "jump").collect();
+    assert_eq!(again.len(), 2);
+    for (a, b) in [(up, again[0]), (down, again[1])] {
+        assert!(
+            (a.phi_over_2pi - b.phi_over_2pi).abs() < 1e-3,
+            "{} vs {}",
+            a.phi_over_2pi,
+            b.phi_over_2pi
+        );
+    }
+}
