@@ -50,6 +50,7 @@ pub fn euler_buckling_load(n: usize, stretching_stiffness: f64) -> Result<f64> {
         k2: 1.0,
         k3: 3.0,
         stretching_stiffness,
+        law: Default::default(),
     };
     let mut newton = Newton::new(RodEnergy::new(model));
     let p_e = 4.0 * PI * PI;
@@ -70,6 +71,7 @@ pub fn greenhill_twisting_moment(n: usize, k3: f64, stretching_stiffness: f64) -
         k2: 1.0,
         k3,
         stretching_stiffness,
+        law: Default::default(),
     };
     let mut newton = Newton::new(RodEnergy::new(model));
     let phi = loss_of_stability(7.0 / k3, 11.0 / k3, |phi| {

@@ -1,7 +1,7 @@
 //! Scene files (TOML): model, clamps, initial shape, solver settings, outputs.
 //! Every field is checked; errors name the field.
 
-use crate::model::rod::{Clamps, Parameter, RodModel};
+use crate::model::rod::{Clamps, Law, Parameter, RodModel};
 use crate::solve::newton::NewtonSettings;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -58,7 +58,8 @@ pub struct Scene {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
-    /// Model kind: only "kirchhoff" for now.
+    /// Model kind: "kirchhoff" (default), "unbendable" (Kirchhoff with u2 = 0
+    /// enforced, K2 → ∞) or "strip" (Sadowsky elastic strip, u2 = 0 enforced).
     #[serde(default = "default_kind")]
     pub kind: String,
     /// B22/B11.
@@ -70,6 +71,10 @@ pub struct ModelSpec {
     /// Number of segments N.
     #[serde(default = "default_segments")]
     pub segments: i64,
+    /// Strip law only: regularisation ε of 1/2 (u1² + u3²)² / (u1² + ε²), a
+    /// curvature in units of 1/L.
+    #[serde(default = "default_strip_regularisation")]
+    pub strip_regularisation: f64,
     /// Rod diameter h (sets the default stretching stiffness 16/h²).
     #[serde(default = "default_diameter")]
     pub rod_diameter: f64,
@@ -77,6 +82,14 @@ pub struct ModelSpec {
     #[serde(default)]
     pub stretching_stiffness: Option<f64>,
 }
+
+fn default_strip_regularisation() -> f64 {
+    STRIP_REGULARISATION
+}
+
+/// Default ε of the strip law: far below the curvatures of the paper's knots
+/// (|u1| ~ 5–30), so it only matters at inflections of a twisted strip.
+pub const STRIP_REGULARISATION: f64 = 0.05;
 
 fn default_kind() -> String {
     "kirchhoff".into()
@@ -404,12 +417,16 @@ impl Scene {
     /// Check every value's range.
     pub fn validate(&self) -> Result<(), SceneError> {
         let m = &self.model;
-        if m.kind != "kirchhoff" {
+        if !["kirchhoff", "unbendable", "strip"].contains(&m.kind.as_str()) {
             return Err(invalid(
                 "model.kind",
-                format!("unknown model `{}` (known: kirchhoff)", m.kind),
+                format!(
+                    "unknown model `{}` (known: kirchhoff, unbendable, strip)",
+                    m.kind
+                ),
             ));
         }
+        positive("model.strip_regularisation", m.strip_regularisation)?;
         positive("model.K2", m.k2)?;
         positive("model.K3", m.k3)?;
         if m.segments < 4 || m.segments > 1_000_000 {
@@ -591,6 +608,13 @@ impl Scene {
             stretching_stiffness: m
                 .stretching_stiffness
                 .unwrap_or_else(|| RodModel::circular_stretching_stiffness(m.rod_diameter)),
+            law: match m.kind.as_str() {
+                "unbendable" => Law::Unbendable,
+                "strip" => Law::Strip {
+                    regularisation: m.strip_regularisation,
+                },
+                _ => Law::Kirchhoff,
+            },
         }
     }
 

@@ -255,6 +255,7 @@ fn analytic_tables() -> Result<String> {
             k2: 1.0,
             k3,
             stretching_stiffness: 640_000.0,
+            law: Default::default(),
         };
         let mut newton = Newton::new(RodEnergy::new(model));
         let mut st = RodState::straight(n, Clamps::new(1.0, 0.0, f));

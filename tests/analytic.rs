@@ -13,6 +13,7 @@ fn model(n: usize, k2: f64, k3: f64) -> RodModel {
         k2,
         k3,
         stretching_stiffness: 640_000.0,
+        law: Default::default(),
     }
 }
 

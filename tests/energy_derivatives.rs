@@ -14,6 +14,7 @@ fn random_state(n: usize, seed: u64) -> (RodModel, RodState) {
         k2: 2.3,
         k3: 1.7,
         stretching_stiffness: 50.0,
+        law: Default::default(),
     };
     let clamps = Clamps::new(0.4, 0.1, 0.37);
     // a non-planar loop with large curvature plus noise

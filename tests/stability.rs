@@ -87,6 +87,7 @@ fn stable_knot(n: usize) {
         k2: 3.0,
         k3: 3.0,
         stretching_stiffness: 640_000.0,
+        law: Default::default(),
     };
     let clamps = Clamps::new(0.115, 0.05, 0.802);
     let sol = ShootingSolution::integrate(
@@ -113,6 +114,7 @@ fn unstable_state_spectrum_matches_dense() {
             k2: 1.0,
             k3: 1.0,
             stretching_stiffness: 1e4,
+            law: Default::default(),
         };
         let st = RodState::straight(n, Clamps::new(1.0, 0.0, 2.5));
         check(&RodEnergy::new(model), &st, true);

@@ -10,7 +10,7 @@
 //! so these derivatives are those of the energy along the solver's own steps.
 
 use crate::model::frames::{self, Scalar, V3, lift};
-use crate::model::rod::{DofMap, RodModel, RodState, tangent};
+use crate::model::rod::{DofMap, Law, RodModel, RodState, tangent};
 use crate::solve::sparse::{NO_SLOT, SymmetricPattern};
 use nalgebra::{SVector, Vector3};
 
@@ -189,15 +189,73 @@ pub fn stretching_energy<T: Scalar>(q: &[T], model: &RodModel) -> T {
     strain * strain * (0.5 * model.stretching_stiffness * h)
 }
 
-fn vertex_energy<T: Scalar>(q: &[T], c: &VertexFrames, model: &RodModel, terms: Terms) -> T {
+/// Material curvatures at one vertex: integrated κ1 = h u1 and κ2 = h u2 (the
+/// curvature binormal on the averaged material directors).
+fn material_curvatures<T: Scalar>(g: &VertexGeometry<T>, q: &[T]) -> (T, T) {
+    let (d1a, d2a) = frames::material_directors(g.t0, g.a0, q[6]);
+    let (d1b, d2b) = frames::material_directors(g.t1, g.a1, q[7]);
+    (
+        frames::dot(g.kb, frames::add(d1a, d1b)) * 0.5,
+        frames::dot(g.kb, frames::add(d2a, d2b)) * 0.5,
+    )
+}
+
+/// Integrated curvature κ2 = h u2 about d2 at one vertex: the strip's
+/// constraint function (u2 = 0).
+pub fn normal_curvature<T: Scalar>(q: &[T], c: &VertexFrames) -> T {
     let g = vertex_geometry(q, c);
+    material_curvatures(&g, q).1
+}
+
+/// Sadowsky energy of a strip at one vertex, h/2 (u1² + u3²)² / (u1² + ε²),
+/// from the integrated curvature κ1 = h u1 and twist m = h u3.
+pub fn strip_energy<T: Scalar>(k1: T, m: T, regularisation: f64, h: f64) -> T {
+    let a = k1 * k1 + m * m;
+    a * a / ((k1 * k1 + (regularisation * h).powi(2)) * (2.0 * h))
+}
+
+/// Multiplier λ of vertex i's constraint κ2 = 0 and the penalty ρ of the
+/// augmented Lagrangian E + Σ (λ κ2 + ρ/2 κ2²).
+#[derive(Clone, Copy, Debug)]
+pub struct VertexMultiplier {
+    /// λ_i.
+    pub lambda: f64,
+    /// ρ.
+    pub penalty: f64,
+}
+
+fn vertex_energy<T: Scalar>(
+    q: &[T],
+    c: &VertexFrames,
+    model: &RodModel,
+    terms: Terms,
+    multiplier: Option<VertexMultiplier>,
+) -> T {
+    let g = vertex_geometry(q, c);
+    let h = model.segment_length();
+    let (k1, k2) = material_curvatures(&g, q);
     let mut e = T::from(0.0);
-    if terms.bending {
-        e += bending_from(&g, q, model);
+    match model.law {
+        Law::Strip { regularisation } => {
+            // bending and twisting do not separate in the strip law
+            if terms.bending || terms.twisting {
+                let m = twist_from(&g, q, c);
+                e += strip_energy(k1, m, regularisation, h);
+            }
+        }
+        law => {
+            if terms.bending {
+                let k2_stiffness = if law == Law::Kirchhoff { model.k2 } else { 0.0 };
+                e += (k1 * k1 + k2 * k2 * k2_stiffness) * (0.5 / h);
+            }
+            if terms.twisting {
+                let m = twist_from(&g, q, c);
+                e += m * m * (0.5 * model.k3 / h);
+            }
+        }
     }
-    if terms.twisting {
-        let m = twist_from(&g, q, c);
-        e += m * m * (0.5 * model.k3 / model.segment_length());
+    if let Some(w) = multiplier {
+        e += k2 * (k2 * (0.5 * w.penalty) + w.lambda);
     }
     e
 }
@@ -222,7 +280,27 @@ pub struct RodEnergy {
     pub terms: Terms,
     /// Hessian pattern: stencils are the N vertices then the N-2 free edges 1..N-1.
     pub pattern: SymmetricPattern,
+    /// Constrained laws: multipliers λ_i of κ2_i = 0 (index i = 1..=N, entry 0
+    /// unused) and the augmented-Lagrangian penalty; the energy evaluated is
+    /// then the augmented Lagrangian E + Σ (λ κ2 + ρ/2 κ2²).
+    pub multipliers: Option<Multipliers>,
 }
+
+/// Multipliers of the u2 = 0 constraints of a constrained law.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Multipliers {
+    /// λ_i per vertex (entry 0 unused): the bending moment m2 that holds
+    /// u2 = 0, integrated over a segment.
+    pub lambda: Vec<f64>,
+    /// ρ: with ρ = PENALTY / h the Hessian of the augmented Lagrangian has the
+    /// inertia of the Hessian reduced to the constraint tangent space, and its
+    /// lowest eigenvalues agree with the reduced ones to O(1/ρ).
+    pub penalty: f64,
+}
+
+/// Penalty of the augmented Lagrangian in units of 1/h: that of a Kirchhoff
+/// rod with K2 = PENALTY.
+pub const PENALTY: f64 = 1e4;
 
 /// Result of a gradient evaluation.
 #[derive(Clone, Copy, Debug)]
@@ -252,12 +330,47 @@ impl RodEnergy {
             stencils.push(map.edge_stencil(j).to_vec());
         }
         let pattern = SymmetricPattern::from_stencils(map.len(), &stencils);
+        let multipliers = model.law.constrained().then(|| Multipliers {
+            lambda: vec![0.0; n + 1],
+            penalty: PENALTY / model.segment_length(),
+        });
         RodEnergy {
             model,
             map,
             terms,
             pattern,
+            multipliers,
         }
+    }
+
+    /// The multiplier term of vertex i, if the law is constrained.
+    fn multiplier(&self, i: usize) -> Option<VertexMultiplier> {
+        self.multipliers.as_ref().map(|m| VertexMultiplier {
+            lambda: m.lambda[i],
+            penalty: m.penalty,
+        })
+    }
+
+    /// The constraints κ2_i = h u2_i (i = 1..=N) and their gradients on the
+    /// 11 node variables of vertex i's stencil.
+    pub fn constraint_rows(&self, state: &RodState) -> Vec<(f64, [f64; 11])> {
+        (1..=self.model.segments)
+            .map(|i| {
+                let c = VertexFrames::at(state, i);
+                let q = SVector::<f64, 8>::from(vertex_variables(state, i));
+                let (v, g8) = num_dual::gradient(
+                    |v: SVector<_, 8>| normal_curvature(v.as_slice(), &c),
+                    &q,
+                );
+                let mut g = [0.0; 11];
+                for (a, ga) in g.iter_mut().enumerate() {
+                    for &(k, alpha) in vertex_chain(a).iter().filter(|c| c.0 != usize::MAX) {
+                        *ga += alpha * g8[k];
+                    }
+                }
+                (v, g)
+            })
+            .collect()
     }
 
     /// Total energy.
@@ -267,7 +380,13 @@ impl RodEnergy {
         if self.terms.bending || self.terms.twisting {
             for i in 1..=n {
                 let q = vertex_variables(state, i);
-                e += vertex_energy(&q, &VertexFrames::at(state, i), &self.model, self.terms);
+                e += vertex_energy(
+                    &q,
+                    &VertexFrames::at(state, i),
+                    &self.model,
+                    self.terms,
+                    self.multiplier(i),
+                );
             }
         }
         if self.terms.stretching {
@@ -282,9 +401,10 @@ impl RodEnergy {
     /// bending and twisting at vertex i.
     pub fn vertex_local(&self, state: &RodState, i: usize) -> (f64, [f64; 11], [f64; 121]) {
         let c = VertexFrames::at(state, i);
+        let w = self.multiplier(i);
         let q = SVector::<f64, 8>::from(vertex_variables(state, i));
         let (e, g8, h8) = num_dual::hessian(
-            |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms),
+            |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms, w),
             &q,
         );
         let (g, h) = vertex_to_nodes(g8.as_slice(), h8.as_slice());
@@ -317,9 +437,10 @@ impl RodEnergy {
 
     fn vertex_gradient(&self, state: &RodState, i: usize) -> (f64, [f64; 11]) {
         let c = VertexFrames::at(state, i);
+        let w = self.multiplier(i);
         let q = SVector::<f64, 8>::from(vertex_variables(state, i));
         let (e, g8) = num_dual::gradient(
-            |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms),
+            |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms, w),
             &q,
         );
         let mut g = [0.0; 11];

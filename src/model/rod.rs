@@ -23,6 +23,46 @@ pub struct RodModel {
     pub k3: f64,
     /// Stretching stiffness EA L^2 / B11 (near-inextensibility penalty).
     pub stretching_stiffness: f64,
+    /// Constitutive law of bending and twisting.
+    #[serde(default)]
+    pub law: Law,
+}
+
+/// Constitutive law of bending and twisting (energy per unit length, in units
+/// of the soft bending stiffness B).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum Law {
+    /// Kirchhoff rod: 1/2 (u1² + K2 u2² + K3 u3²).
+    #[default]
+    Kirchhoff,
+    /// Kirchhoff rod with K2 → ∞: u2 = 0 enforced as a constraint,
+    /// energy 1/2 (u1² + K3 u3²).
+    Unbendable,
+    /// Elastic strip (Sadowsky, paper eq. 4.2): u2 = 0 enforced,
+    /// energy 1/2 (u1² + u3²)² / (u1² + ε²). The regularisation ε (a
+    /// curvature, in units of 1/L) keeps the energy finite where u1 → 0 with
+    /// u3 ≠ 0; it changes the law only where |u1| is comparable to ε.
+    Strip {
+        /// ε.
+        regularisation: f64,
+    },
+}
+
+impl Law {
+    /// Whether u2 = 0 is a constraint (solved by SQP rather than Newton).
+    pub fn constrained(&self) -> bool {
+        !matches!(self, Law::Kirchhoff)
+    }
+
+    /// Short name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Law::Kirchhoff => "Kirchhoff rod",
+            Law::Unbendable => "Kirchhoff rod with u2 = 0",
+            Law::Strip { .. } => "elastic strip",
+        }
+    }
 }
 
 impl RodModel {

@@ -3,6 +3,7 @@
 pub mod continuation;
 pub mod newton;
 pub mod sparse;
+pub mod sqp;
 
 /// Process-wide work counters, read by `knotrod bench`.
 pub mod counters {

@@ -47,7 +47,7 @@ pub struct NewtonReport {
 }
 
 impl NewtonReport {
-    fn start() -> Self {
+    pub(crate) fn start() -> Self {
         NewtonReport {
             converged: false,
             iterations: 0,
@@ -58,14 +58,14 @@ impl NewtonReport {
         }
     }
 
-    fn record(&mut self, iteration: usize, rel: f64, energy: f64) {
+    pub(crate) fn record(&mut self, iteration: usize, rel: f64, energy: f64) {
         self.residual_history.push(rel);
         self.gradient_norm = rel;
         self.energy = energy;
         self.iterations = iteration;
     }
 
-    fn not_converged(&self) -> SolveError {
+    pub(crate) fn not_converged(&self) -> SolveError {
         let h = &self.residual_history;
         SolveError::NotConverged {
             iterations: self.iterations,
@@ -241,6 +241,10 @@ impl Newton {
         state: &mut RodState,
         settings: &NewtonSettings,
     ) -> Result<NewtonReport, SolveError> {
+        if self.energy.multipliers.is_some() {
+            // constrained laws: SQP, each step a QP solved by clarabel
+            return crate::solve::sqp::minimize(self, state, settings);
+        }
         let mut report = NewtonReport::start();
         let mut shift = 0.0f64;
         let mut next_shift = 0.0f64;
