@@ -7,7 +7,7 @@ use crate::geometry::knot::{KnotType, knot_type};
 use crate::geometry::walls::wall_clearance;
 use crate::geometry::writhe::writhe_closed;
 use crate::model::energy::RodEnergy;
-use crate::model::rod::{RodModel, RodState};
+use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
 use crate::scene::{InitialShape, Scene};
 use crate::solve::newton::{Newton, NewtonReport};
@@ -119,6 +119,21 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
                 )
             }
         },
+        InitialShape::DoubleRing => {
+            // a circle of circumference 1/2 traced twice in the (y, z) plane,
+            // bent about d1 = e1 everywhere (paper Sec. 6); the clamps are the
+            // scene's, so small z*, δ, 2π − φ start the unfolding directly
+            let r = 1.0 / (4.0 * std::f64::consts::PI);
+            RodState::from_curve(
+                n,
+                clamps,
+                move |s| {
+                    let a = 4.0 * std::f64::consts::PI * s;
+                    Vector3::new(0.0, -r * (1.0 - a.cos()), r * a.sin())
+                },
+                |_| Vector3::x(),
+            )
+        }
         InitialShape::Shooting => {
             let (mut n0, mut m0) = (
                 Vector3::from(init.n0.context("initial.n0 missing")?),
@@ -308,8 +323,32 @@ pub fn starting_equilibrium(
     segments: Option<usize>,
 ) -> Result<(Newton, RodState, NewtonReport)> {
     let model = scene.rod_model(segments);
+    let mut newton = Newton::new(RodEnergy::new(model.clone()));
+    if scene.initial.shape == InitialShape::DoubleRing {
+        // unfold the double ring quasi-statically: straight from its own
+        // clamps (0, 0, 2π) to the scene's
+        let ring = Clamps::new(0.0, 0.0, 1.0);
+        let mut state = initial_state(scene, &model)?;
+        state.set_clamps(ring);
+        let mut report = newton
+            .minimize(&mut state, &scene.solver)
+            .context("the double ring")?;
+        let target = scene.clamps();
+        let steps = scene.initial.steps.map_or(40, |s| s as usize);
+        for k in 1..=steps {
+            let f = k as f64 / steps as f64;
+            let c = Clamps {
+                z_star: f * target.z_star,
+                delta: f * target.delta,
+                phi: ring.phi + f * (target.phi - ring.phi),
+            };
+            let step = crate::loading::carry(&mut newton, &state, c, &scene.solver)
+                .with_context(|| format!("unfolding the double ring, step {k} of {steps}"))?;
+            (state, report) = (step.state, step.report);
+        }
+        return Ok((newton, state, report));
+    }
     let mut state = initial_state(scene, &model)?;
-    let mut newton = Newton::new(RodEnergy::new(model));
     let report = newton
         .minimize(&mut state, &scene.solver)
         .context("Newton minimisation")?;

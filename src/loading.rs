@@ -119,18 +119,21 @@ fn predict(newton: &mut Newton, state: &RodState, c: Clamps) -> Result<RodState>
 pub const JUMP_LOCATION: f64 = 1e-4;
 
 /// One quasi-static step: the settled state, and whether it jumped.
-struct Step {
-    state: RodState,
-    report: crate::solve::newton::NewtonReport,
+pub struct Step {
+    /// The settled state.
+    pub state: RodState,
+    /// How the minimiser got there.
+    pub report: crate::solve::newton::NewtonReport,
     /// Distance from the first-order prediction.
-    miss: f64,
-    jumped: bool,
+    pub miss: f64,
+    /// Whether it landed far from the prediction.
+    pub jumped: bool,
 }
 
 /// Move the clamps of the equilibrium `state` to `c` and settle: first-order
 /// prediction along the branch (dq = −H⁻¹ ∂_p∇E), then minimisation. A smooth
 /// branch lands within second order of the prediction; a jump lands far away.
-fn carry(
+pub fn carry(
     newton: &mut Newton,
     state: &RodState,
     c: Clamps,

@@ -122,7 +122,7 @@ pub struct ClampSpec {
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
-    /// "straight" (default), "shooting" or "file".
+    /// "straight" (default), "shooting", "file" or "double_ring".
     #[serde(default)]
     pub shape: InitialShape,
     /// Shooting data: n(0) in the material frame.
@@ -164,6 +164,10 @@ pub enum InitialShape {
     Shooting,
     /// A state from a previous run's JSON summary.
     File,
+    /// The doubly covered ring (z* = δ = 0, φ = 2π; paper Sec. 6), with the
+    /// clamps of the scene.
+    #[serde(rename = "double_ring")]
+    DoubleRing,
 }
 
 /// `[stability]`

@@ -280,22 +280,12 @@ pub struct RodEnergy {
     pub terms: Terms,
     /// Hessian pattern: stencils are the N vertices then the N-2 free edges 1..N-1.
     pub pattern: SymmetricPattern,
-    /// Constrained laws: multipliers λ_i of κ2_i = 0 (index i = 1..=N, entry 0
-    /// unused) and the augmented-Lagrangian penalty; the energy evaluated is
-    /// then the augmented Lagrangian E + Σ (λ κ2 + ρ/2 κ2²).
-    pub multipliers: Option<Multipliers>,
-}
-
-/// Multipliers of the u2 = 0 constraints of a constrained law.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Multipliers {
-    /// λ_i per vertex (entry 0 unused): the bending moment m2 that holds
-    /// u2 = 0, integrated over a segment.
-    pub lambda: Vec<f64>,
-    /// ρ: with ρ = PENALTY / h the Hessian of the augmented Lagrangian has the
-    /// inertia of the Hessian reduced to the constraint tangent space, and its
-    /// lowest eigenvalues agree with the reduced ones to O(1/ρ).
-    pub penalty: f64,
+    /// Constrained laws: the penalty ρ of the augmented Lagrangian
+    /// E + Σ (λ_i κ2_i + ρ/2 κ2_i²) evaluated in their place (λ from the
+    /// state). With ρ = PENALTY / h its Hessian has the inertia of the Hessian
+    /// reduced to the constraint tangent space, and its lowest eigenvalues
+    /// agree with the reduced ones to O(1/ρ).
+    pub penalty: Option<f64>,
 }
 
 /// Penalty of the augmented Lagrangian in units of 1/h: that of a Kirchhoff
@@ -330,24 +320,24 @@ impl RodEnergy {
             stencils.push(map.edge_stencil(j).to_vec());
         }
         let pattern = SymmetricPattern::from_stencils(map.len(), &stencils);
-        let multipliers = model.law.constrained().then(|| Multipliers {
-            lambda: vec![0.0; n + 1],
-            penalty: PENALTY / model.segment_length(),
-        });
+        let penalty = model
+            .law
+            .constrained()
+            .then(|| PENALTY / model.segment_length());
         RodEnergy {
             model,
             map,
             terms,
             pattern,
-            multipliers,
+            penalty,
         }
     }
 
     /// The multiplier term of vertex i, if the law is constrained.
-    fn multiplier(&self, i: usize) -> Option<VertexMultiplier> {
-        self.multipliers.as_ref().map(|m| VertexMultiplier {
-            lambda: m.lambda[i],
-            penalty: m.penalty,
+    fn multiplier(&self, state: &RodState, i: usize) -> Option<VertexMultiplier> {
+        self.penalty.map(|penalty| VertexMultiplier {
+            lambda: state.multipliers.get(i).copied().unwrap_or(0.0),
+            penalty,
         })
     }
 
@@ -385,7 +375,7 @@ impl RodEnergy {
                     &VertexFrames::at(state, i),
                     &self.model,
                     self.terms,
-                    self.multiplier(i),
+                    self.multiplier(state, i),
                 );
             }
         }
@@ -401,7 +391,7 @@ impl RodEnergy {
     /// bending and twisting at vertex i.
     pub fn vertex_local(&self, state: &RodState, i: usize) -> (f64, [f64; 11], [f64; 121]) {
         let c = VertexFrames::at(state, i);
-        let w = self.multiplier(i);
+        let w = self.multiplier(state, i);
         let q = SVector::<f64, 8>::from(vertex_variables(state, i));
         let (e, g8, h8) = num_dual::hessian(
             |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms, w),
@@ -437,7 +427,7 @@ impl RodEnergy {
 
     fn vertex_gradient(&self, state: &RodState, i: usize) -> (f64, [f64; 11]) {
         let c = VertexFrames::at(state, i);
-        let w = self.multiplier(i);
+        let w = self.multiplier(state, i);
         let q = SVector::<f64, 8>::from(vertex_variables(state, i));
         let (e, g8) = num_dual::gradient(
             |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms, w),
@@ -617,6 +607,40 @@ impl RodEnergy {
     }
 }
 
+impl RodEnergy {
+    /// Velocity of vertex i's 11 stencil variables (nodes i-1, i, i+1, angles
+    /// i-1, i) when the s = 1 clamp moves with `velocity`.
+    fn clamp_local_velocity(&self, i: usize, velocity: &ClampVelocity) -> [f64; 11] {
+        let n = self.model.segments;
+        let mut vel = [0.0; 11];
+        for (k, node) in [i - 1, i, i + 1].into_iter().enumerate() {
+            if node >= n {
+                vel[3 * k..3 * k + 3].copy_from_slice(velocity.end.as_slice());
+            }
+        }
+        if i == n {
+            vel[10] = velocity.theta;
+        }
+        vel
+    }
+
+    /// ∂κ2_i/∂p for every constraint row (from `constraint_rows`) when the
+    /// s = 1 clamp moves with `velocity`: nonzero at the last two vertices.
+    pub fn constraint_parameter_derivative(
+        &self,
+        rows: &[(f64, [f64; 11])],
+        velocity: &ClampVelocity,
+        out: &mut [f64],
+    ) {
+        let n = self.model.segments;
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for i in [n - 1, n] {
+            let vel = self.clamp_local_velocity(i, velocity);
+            out[i - 1] = rows[i - 1].1.iter().zip(&vel).map(|(g, v)| g * v).sum();
+        }
+    }
+}
+
 /// Velocity of the s = 1 clamp's dofs with respect to a loading parameter:
 /// both clamp nodes translate by `end`, the clamp angle turns by `theta`.
 #[derive(Clone, Copy, Debug)]
@@ -643,16 +667,7 @@ impl RodEnergy {
         if self.terms.bending || self.terms.twisting {
             for i in [n - 1, n] {
                 let (_, _, hl) = self.vertex_local(state, i);
-                // local velocity: nodes i-1, i, i+1 and angles i-1, i
-                let mut vel = [0.0; 11];
-                for (k, node) in [i - 1, i, i + 1].into_iter().enumerate() {
-                    if node >= n {
-                        vel[3 * k..3 * k + 3].copy_from_slice(e.as_slice());
-                    }
-                }
-                if i == n {
-                    vel[10] = velocity.theta;
-                }
+                let vel = self.clamp_local_velocity(i, velocity);
                 for (a, d) in self.map.vertex_stencil(i).iter().enumerate() {
                     if let Some(d) = d {
                         out[*d] += (0..11).map(|b| hl[a * 11 + b] * vel[b]).sum::<f64>();

@@ -191,6 +191,12 @@ pub struct RodState {
     pub reference: Vec<Vector3<f64>>,
     /// Reference twist at each vertex (index 0 unused).
     pub reference_twist: Vec<f64>,
+    /// Constrained laws: multiplier λ_i of u2 = 0 at each vertex (index 0
+    /// unused; empty means all zero), part of a constrained equilibrium like
+    /// the nodes are: ∇E + Σ λ_i ∇κ2_i = 0 (−λ_i/h is the moment m2 that keeps
+    /// the strip from bending in its plane).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub multipliers: Vec<f64>,
 }
 
 /// Unit tangent of edge j.
@@ -284,6 +290,7 @@ impl RodState {
             theta,
             reference,
             reference_twist,
+            multipliers: Vec::new(),
         }
     }
 
@@ -321,6 +328,7 @@ impl RodState {
         next.clamps = clamps;
         next.nodes.copy_from_slice(&self.nodes);
         next.theta.copy_from_slice(&self.theta);
+        next.multipliers.clone_from(&self.multipliers);
         let shift = clamps.end_point() - self.clamps.end_point();
         next.nodes[n] += shift;
         next.nodes[n + 1] += shift;

@@ -2,10 +2,14 @@
 //! parameter p: tangent predictor, Newton corrector on the bordered system
 //! [H  ∂_p∇E; w τ_qᵀ  τ_p] (block elimination with the sparse LDLᵀ of H, which
 //! need not be definite), adaptive step, and location of events by bisection
-//! in arclength on a test function.
+//! in arclength on a test function. Constrained laws (the strip's u2 = 0) are
+//! continued on the KKT system instead: unknowns (q, λ), the constraint rows
+//! bordered in, stability from the inertia reduced to the tangent space.
 
 use crate::model::rod::{Parameter, RodState};
+use crate::solve::kkt::Kkt;
 use crate::solve::newton::{Newton, SolveError, residual};
+use crate::solve::sparse::Ldlt;
 use serde::{Deserialize, Serialize};
 
 /// Settings of one continuation.
@@ -47,7 +51,7 @@ impl Default for ContinuationSettings {
 pub struct Point {
     /// The equilibrium.
     pub state: RodState,
-    /// Tangent on the free dofs.
+    /// Tangent on the free dofs (then on the multipliers, for constrained laws).
     pub tangent_q: Vec<f64>,
     /// Tangent component along the parameter (dp/ds).
     pub tangent_p: f64,
@@ -95,6 +99,10 @@ pub struct Tracer<'a> {
     b: Vec<f64>,
     /// Weight of the dofs in the arclength norm (1/number of dofs).
     weight: f64,
+    /// Number of free dofs (the multipliers follow them in the vectors).
+    dofs: usize,
+    /// Constrained laws: the KKT system.
+    kkt: Option<Kkt>,
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -109,16 +117,52 @@ impl<'a> Tracer<'a> {
         settings: ContinuationSettings,
     ) -> Self {
         let n = newton.energy.map.len();
+        let kkt = newton.energy.penalty.map(|_| Kkt::new(&newton.energy));
+        let dim = n + kkt.as_ref().map_or(0, |k| k.constraints);
         Tracer {
             newton,
             parameter,
             settings,
-            grad: vec![0.0; n],
+            grad: vec![0.0; dim],
             values: vec![],
-            fp: vec![0.0; n],
-            a: vec![0.0; n],
-            b: vec![0.0; n],
+            fp: vec![0.0; dim],
+            a: vec![0.0; dim],
+            b: vec![0.0; dim],
             weight: 1.0 / n as f64,
+            dofs: n,
+            kkt,
+        }
+    }
+
+    /// The factorisation of the last linearisation.
+    fn solver(&mut self) -> &mut Ldlt {
+        match &mut self.kkt {
+            Some(k) => &mut k.ldlt,
+            None => &mut self.newton.ldlt,
+        }
+    }
+
+    /// Negative eigenvalues of the (reduced) Hessian at the last linearisation.
+    fn negative_count(&self) -> usize {
+        match &self.kkt {
+            Some(k) => k.reduced_negative_count(),
+            None => self.newton.ldlt.negative_count(),
+        }
+    }
+
+    /// Dot product over the dofs (not the multipliers): the arclength metric.
+    fn dot_q(&self, a: &[f64], b: &[f64]) -> f64 {
+        dot(&a[..self.dofs], &b[..self.dofs])
+    }
+
+    /// Apply a step (dofs, then multipliers) and move the clamps.
+    fn step_into(&self, from: &RodState, dq: &[f64], p: f64, next: &mut RodState) {
+        let map = self.newton.energy.map;
+        from.move_into(&map, &dq[..self.dofs], self.parameter.with(&from.clamps, p), next);
+        if self.kkt.is_some() {
+            for (l, d) in next.multipliers[1..].iter_mut().zip(&dq[self.dofs..]) {
+                *l += d;
+            }
         }
     }
 
@@ -131,11 +175,24 @@ impl<'a> Tracer<'a> {
     /// relative gradient and the round-off floor test.
     fn linearise(&mut self, state: &RodState) -> Result<(f64, bool), ContinuationError> {
         let energy = &self.newton.energy;
+        let n = self.dofs;
         self.values.resize(energy.pattern.nnz(), 0.0);
-        let info = energy.hessian(state, &mut self.grad, &mut self.values);
+        let info = energy.hessian(state, &mut self.grad[..n], &mut self.values);
         let velocity = self.parameter.velocity(&state.clamps);
-        energy.gradient_parameter_derivative(state, &velocity, &mut self.fp);
-        let gnorm = dot(&self.grad, &self.grad).sqrt();
+        energy.gradient_parameter_derivative(state, &velocity, &mut self.fp[..n]);
+        let gnorm = dot(&self.grad[..n], &self.grad[..n]).sqrt();
+        let mut infeasibility = 0.0f64;
+        if let Some(kkt) = &mut self.kkt {
+            // residual (∇E + Jᵀ(λ + ρc), c) and its parameter derivative
+            let rows = energy.constraint_rows(state);
+            for (g, r) in self.grad[n..].iter_mut().zip(&rows) {
+                *g = r.0;
+            }
+            energy.constraint_parameter_derivative(&rows, &velocity, &mut self.fp[n..]);
+            kkt.assemble(&self.values, &rows);
+            let h = energy.model.segment_length();
+            infeasibility = rows.iter().map(|r| (r.0 / h).abs()).fold(0.0, f64::max);
+        }
         if !gnorm.is_finite() || self.values.iter().any(|v| !v.is_finite()) {
             return Err(ContinuationError::NonFinite("gradient/Hessian"));
         }
@@ -145,11 +202,15 @@ impl<'a> Tracer<'a> {
             .iter()
             .map(|&s| self.values[s].abs())
             .fold(0.0, f64::max);
-        let (rel, at_floor) = residual(&info, gnorm, max_diag, state, self.grad.len());
-        self.newton
-            .ldlt
-            .factor(&self.values)
-            .map_err(|_| ContinuationError::Singular("linearisation"))?;
+        let (rel, at_floor) = residual(&info, gnorm, max_diag, state, n);
+        let factored = match &mut self.kkt {
+            Some(k) => k.ldlt.factor(&k.values),
+            None => self.newton.ldlt.factor(&self.values),
+        };
+        factored.map_err(|_| ContinuationError::Singular("linearisation"))?;
+        if infeasibility > crate::solve::sqp::CURVATURE_TOL {
+            return Ok((rel.max(infeasibility), false));
+        }
         Ok((rel, at_floor))
     }
 
@@ -157,13 +218,15 @@ impl<'a> Tracer<'a> {
     /// (v, 1) with H v = -∂_p∇E, normalised, oriented along `orient`.
     fn tangent(&mut self, orient: Option<(&[f64], f64)>, sign: f64) -> (Vec<f64>, f64) {
         self.b.copy_from_slice(&self.fp);
-        self.newton.ldlt.solve_in_place(&mut self.b);
+        let mut b = std::mem::take(&mut self.b);
+        self.solver().solve_in_place(&mut b);
+        self.b = b;
         let v: Vec<f64> = self.b.iter().map(|x| -x).collect();
-        let norm = (self.weight * dot(&v, &v) + 1.0).sqrt();
+        let norm = (self.weight * self.dot_q(&v, &v) + 1.0).sqrt();
         let mut tq: Vec<f64> = v.iter().map(|x| x / norm).collect();
         let mut tp = 1.0 / norm;
         let s = match orient {
-            Some((q, p)) => self.weight * dot(&tq, q) + tp * p,
+            Some((q, p)) => self.weight * self.dot_q(&tq, q) + tp * p,
             None => sign,
         };
         if s < 0.0 {
@@ -175,9 +238,12 @@ impl<'a> Tracer<'a> {
 
     /// A branch point from an equilibrium `state`, its tangent oriented so that
     /// the parameter moves in the direction of `sign` (±1).
-    pub fn start(&mut self, state: RodState, sign: f64) -> Result<Point, ContinuationError> {
+    pub fn start(&mut self, mut state: RodState, sign: f64) -> Result<Point, ContinuationError> {
+        if let Some(k) = &self.kkt {
+            state.multipliers.resize(k.constraints + 1, 0.0);
+        }
         let (residual, _) = self.linearise(&state)?;
-        let negative_count = self.newton.ldlt.negative_count();
+        let negative_count = self.negative_count();
         let (tangent_q, tangent_p) = self.tangent(None, sign);
         Ok(Point {
             state,
@@ -199,7 +265,8 @@ impl<'a> Tracer<'a> {
         direction: Option<(&[f64], f64)>,
     ) -> Result<Point, ContinuationError> {
         let (tq, tp) = direction.unwrap_or((&from.tangent_q, from.tangent_p));
-        let tq = tq.to_vec();
+        let mut tq = tq.to_vec();
+        tq.resize(self.a.len(), 0.0);
         let map = self.newton.energy.map;
         let p_pred = self.parameter_of(&from.state) + sigma * tp;
         let mut state = from.state.clone();
@@ -207,23 +274,18 @@ impl<'a> Tracer<'a> {
         for (a, t) in self.a.iter_mut().zip(&tq) {
             *a = sigma * t;
         }
-        from.state.move_into(
-            &map,
-            &self.a,
-            self.parameter.with(&from.state.clamps, p_pred),
-            &mut state,
-        );
+        self.step_into(&from.state, &self.a, p_pred, &mut state);
         let mut offset = vec![0.0; tq.len()];
         let mut p = p_pred;
         for it in 0..=self.settings.max_corrector_iterations {
             crate::solve::counters::NEWTON_ITERATIONS
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let (rel, at_floor) = self.linearise(&state)?;
-            let c = self.weight * dot(&tq, &offset) + tp * (p - p_pred);
+            let c = self.weight * self.dot_q(&tq, &offset) + tp * (p - p_pred);
             if (rel <= self.settings.tolerance || at_floor)
                 && c.abs() <= 1e-10 * sigma.abs().max(1e-12)
             {
-                let negative_count = self.newton.ldlt.negative_count();
+                let negative_count = self.negative_count();
                 let orient = (from.tangent_q.as_slice(), from.tangent_p);
                 let (tangent_q, tangent_p) = self.tangent(Some(orient), 1.0);
                 return Ok(Point {
@@ -233,19 +295,24 @@ impl<'a> Tracer<'a> {
                     negative_count,
                     iterations: it,
                     residual: rel,
-                    correction: (self.weight * dot(&offset, &offset) + (p - p_pred).powi(2)).sqrt()
+                    correction: (self.weight * self.dot_q(&offset, &offset)
+                        + (p - p_pred).powi(2))
+                    .sqrt()
                         / sigma.abs().max(1e-300),
                 });
             }
             if it == self.settings.max_corrector_iterations {
                 break;
             }
-            self.a.copy_from_slice(&self.grad);
-            self.newton.ldlt.solve_in_place(&mut self.a);
-            self.b.copy_from_slice(&self.fp);
-            self.newton.ldlt.solve_in_place(&mut self.b);
-            let denom = tp - self.weight * dot(&tq, &self.b);
-            let dp = (-c + self.weight * dot(&tq, &self.a)) / denom;
+            let (mut a, mut b) = (std::mem::take(&mut self.a), std::mem::take(&mut self.b));
+            a.copy_from_slice(&self.grad);
+            b.copy_from_slice(&self.fp);
+            let solver = self.solver();
+            solver.solve_in_place(&mut a);
+            solver.solve_in_place(&mut b);
+            (self.a, self.b) = (a, b);
+            let denom = tp - self.weight * self.dot_q(&tq, &self.b);
+            let dp = (-c + self.weight * self.dot_q(&tq, &self.a)) / denom;
             if !dp.is_finite() {
                 return Err(ContinuationError::NonFinite("corrector"));
             }
@@ -255,7 +322,7 @@ impl<'a> Tracer<'a> {
             }
             let dq = &self.a;
             // a corrector that moves far is not converging to this branch
-            let largest = (0..dq.len())
+            let largest = (0..self.dofs)
                 .filter(|&d| map.is_translation(d))
                 .map(|d| dq[d].abs())
                 .fold(0.0, f64::max);
@@ -263,7 +330,7 @@ impl<'a> Tracer<'a> {
                 return Err(ContinuationError::Corrector(it + 1));
             }
             p += dp;
-            state.move_into(&map, dq, self.parameter.with(&state.clamps, p), &mut next);
+            self.step_into(&state, dq, p, &mut next);
             std::mem::swap(&mut state, &mut next);
             offset.iter_mut().zip(dq).for_each(|(o, d)| *o += d);
         }
@@ -327,11 +394,14 @@ impl<'a> Tracer<'a> {
         } else {
             0
         };
-        Ok((sp.values[k], sp.vectors[k].clone()))
+        // constrained laws: the mode lives on the dofs, multipliers follow
+        let mut v = sp.vectors[k].clone();
+        v.resize(self.a.len(), 0.0);
+        Ok((sp.values[k], v))
     }
 
     /// Weighted norm of a dof vector.
     pub fn weighted_norm(&self, q: &[f64]) -> f64 {
-        (self.weight * dot(q, q)).sqrt()
+        (self.weight * self.dot_q(q, q)).sqrt()
     }
 }

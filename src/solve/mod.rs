@@ -1,6 +1,7 @@
 //! Solvers: sparse linear algebra and Newton's method for equilibria.
 
 pub mod continuation;
+pub mod kkt;
 pub mod newton;
 pub mod sparse;
 pub mod sqp;

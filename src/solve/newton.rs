@@ -241,7 +241,7 @@ impl Newton {
         state: &mut RodState,
         settings: &NewtonSettings,
     ) -> Result<NewtonReport, SolveError> {
-        if self.energy.multipliers.is_some() {
+        if self.energy.penalty.is_some() {
             // constrained laws: SQP, each step a QP solved by clarabel
             return crate::solve::sqp::minimize(self, state, settings);
         }

@@ -154,6 +154,14 @@ pub struct SingularPivot;
 impl Ldlt {
     /// Symbolic analysis of the pattern (natural order: our dofs are banded).
     pub fn new(pattern: &SymmetricPattern) -> Self {
+        Self::with_order(pattern, None)
+    }
+
+    /// Symbolic analysis with the unknowns eliminated in the given order
+    /// (`order[k]` is the unknown eliminated k-th), e.g. each multiplier of a
+    /// KKT matrix right after the unknowns of its constraint, which keeps the
+    /// factor banded and every pivot nonzero without pivoting.
+    pub fn with_order(pattern: &SymmetricPattern, order: Option<&[usize]>) -> Self {
         let n = pattern.dim();
         let col_ptr = pattern.matrix.col_offsets().to_vec();
         let row_idx = pattern.matrix.row_indices().to_vec();
@@ -162,9 +170,21 @@ impl Ldlt {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
             ..Default::default()
         };
-        let symbolic =
-            factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Identity, params)
-                .expect("symbolic Cholesky of a valid pattern");
+        let symbolic = match order {
+            None => {
+                factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Identity, params)
+            }
+            Some(order) => {
+                let fwd = order.to_vec();
+                let mut inv = vec![0usize; n];
+                for (k, &o) in fwd.iter().enumerate() {
+                    inv[o] = k;
+                }
+                let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
+                factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Custom(perm), params)
+            }
+        }
+        .expect("symbolic Cholesky of a valid pattern");
         let factor = vec![0.0; symbolic.len_val()];
         let req = symbolic
             .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Spec::<LdltParams, f64>::default())

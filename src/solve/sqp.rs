@@ -107,7 +107,7 @@ fn qp_settings() -> DefaultSettings<f64> {
 }
 
 /// Minimise the energy of a constrained rod from `state` (updated in place);
-/// the multipliers are left in `newton.energy.multipliers`.
+/// its multipliers are updated with it.
 pub fn minimize(
     newton: &mut Newton,
     state: &mut RodState,
@@ -116,12 +116,9 @@ pub fn minimize(
     let map = newton.energy.map;
     let n = map.len();
     let h = newton.energy.model.segment_length();
-    let penalty = newton
-        .energy
-        .multipliers
-        .as_ref()
-        .expect("a constrained law")
-        .penalty;
+    let penalty = newton.energy.penalty.expect("a constrained law");
+    let segments = newton.energy.model.segments;
+    state.multipliers.resize(segments + 1, 0.0);
     let nnz = newton.energy.pattern.nnz();
     let mut grad = vec![0.0; n];
     let mut values = vec![0.0; nnz];
@@ -192,9 +189,8 @@ pub fn minimize(
             }
         }
         // QP: linear term ∇E + ρ Jᵀc = ∇(augmented) − Jᵀλ
-        let lambda = &newton.energy.multipliers.as_ref().unwrap().lambda;
         let mut jtl = vec![0.0; n];
-        jacobian.transpose_mul(&lambda[1..], &mut jtl);
+        jacobian.transpose_mul(&state.multipliers[1..], &mut jtl);
         let q: Vec<f64> = grad.iter().zip(&jtl).map(|(g, j)| g - j).collect();
         let b: Vec<f64> = c.iter().map(|x| -x).collect();
         let (d, new_lambda) = solve_qp(
@@ -218,10 +214,7 @@ pub fn minimize(
             step.iter_mut().for_each(|v| *v *= f);
         }
         // merit: the augmented Lagrangian with the new multipliers
-        {
-            let m = newton.energy.multipliers.as_mut().unwrap();
-            m.lambda[1..].copy_from_slice(&new_lambda);
-        }
+        state.multipliers[1..].copy_from_slice(&new_lambda);
         let merit_info = newton.energy.gradient(state, &mut grad);
         let slope: f64 = step.iter().zip(&grad).map(|(s, g)| s * g).sum();
         let mut alpha = 1.0;
