@@ -332,10 +332,9 @@ fn run(
     let mut out = std::io::stdout().lock();
     writeln!(
         out,
-        "scene {} — Kirchhoff rod, K2 = {}, K3 = {}, N = {} ({:.2} s, {} equilibria)",
+        "scene {} — {}, N = {} ({:.2} s, {} equilibria)",
         summary.scene,
-        model.k2,
-        model.k3,
+        model.describe(),
         model.segments,
         start.elapsed().as_secs_f64(),
         summary.equilibria.len()

@@ -6,8 +6,8 @@ use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
 use crate::geometry::knot::{KnotType, knot_type};
 use crate::geometry::walls::wall_clearance;
 use crate::geometry::writhe::writhe_closed;
-use crate::model::energy::RodEnergy;
-use crate::model::rod::{Clamps, RodModel, RodState};
+use crate::model::energy::{RodEnergy, vertex_strains};
+use crate::model::rod::{Clamps, Law, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
 use crate::scene::{InitialShape, Scene};
 use crate::solve::newton::{Newton, NewtonReport};
@@ -77,6 +77,19 @@ pub struct Equilibrium {
     pub ray_distance: [f64; 2],
     /// Walled, trefoil, stable and no closer to itself than the rod diameter.
     pub good_knot: bool,
+    /// Constrained laws: largest |u2| over the vertices (the residual of the
+    /// constraint u2 = 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_u2: Option<f64>,
+    /// Strip law: smallest |u1| over the vertices. Where it is comparable to
+    /// the regularisation ε while the twist is not small, the Sadowsky energy
+    /// is singular and the result depends on ε (see `regularised`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_u1: Option<f64>,
+    /// Strip law: some vertex has |u1| < 3ε with |u3| > ε, i.e. the
+    /// regularisation, not the Sadowsky law, decides its shape there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub regularised: Option<bool>,
     /// Branch this equilibrium lies on (0 for a single solve).
     #[serde(default)]
     pub branch: usize,
@@ -276,6 +289,35 @@ pub fn analyse(
     let twist = state.twist();
     let walled = min_z > 0.0 && max_z < z_star;
     let min_self_distance = shape.self_approach.map_or(f64::INFINITY, |a| a.distance);
+    let law = newton.energy.model.law;
+    let strains: Vec<[f64; 3]> = if law.constrained() {
+        (1..=state.segments())
+            .map(|i| vertex_strains(state, i))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let max_u2 = law
+        .constrained()
+        .then(|| strains.iter().map(|u| u[1].abs()).fold(0.0, f64::max));
+    let (min_u1, regularised) = match law {
+        Law::Strip {
+            regularisation: eps,
+        } => (
+            Some(
+                strains
+                    .iter()
+                    .map(|u| u[0].abs())
+                    .fold(f64::INFINITY, f64::min),
+            ),
+            Some(
+                strains
+                    .iter()
+                    .any(|u| u[0].abs() < 3.0 * eps && u[2].abs() > eps),
+            ),
+        ),
+        _ => (None, None),
+    };
     Ok(Equilibrium {
         z_star,
         delta: state.clamps.delta,
@@ -310,6 +352,9 @@ pub fn analyse(
         min_self_distance_s: shape.self_approach.map_or([f64::NAN; 2], |a| a.s),
         wall_distance: shape.wall_distance,
         ray_distance: shape.ray_distance,
+        max_u2,
+        min_u1,
+        regularised,
         branch: 0,
         leg: 0,
         state: state.clone(),

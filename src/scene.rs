@@ -134,7 +134,8 @@ pub struct InitialSpec {
     /// Refine the shooting data by Newton on the s = 1 boundary conditions first.
     #[serde(default)]
     pub refine: bool,
-    /// RK4 steps for the shooting integration.
+    /// RK4 steps for the shooting integration; for "double_ring", the
+    /// quasi-static steps that unfold it to the scene's clamps (default 40).
     #[serde(default)]
     pub steps: Option<i64>,
     /// A previous run's JSON summary.
@@ -478,12 +479,18 @@ impl Scene {
                 finite("initial.m0", v)?;
             }
         }
+        // RK4 steps of a shooting start, or unfolding steps of the double ring
+        let least = if i.shape == InitialShape::DoubleRing {
+            1
+        } else {
+            10
+        };
         if let Some(s) = i.steps
-            && !(10..=10_000_000).contains(&s)
+            && !(least..=10_000_000).contains(&s)
         {
             return Err(invalid(
                 "initial.steps",
-                format!("must be in 10..=10000000, got {s}"),
+                format!("must be in {least}..=10000000, got {s}"),
             ));
         }
         if i.shape == InitialShape::File && i.file.is_none() {

@@ -113,6 +113,17 @@ pub fn print_equilibrium(
     writeln!(out, "  n(0) = {}", vec3(&e.n0))?;
     writeln!(out, "  m(0) = {}", vec3(&e.m0))?;
     writeln!(out, "  twist Tw = {:.5}", e.twist)?;
+    if let Some(u2) = e.max_u2 {
+        writeln!(out, "  constraint: max |u2| = {u2:.2e}")?;
+    }
+    if let (Some(u1), Some(reg)) = (e.min_u1, e.regularised) {
+        let note = if reg {
+            " — near the Sadowsky singularity: the regularisation decides the shape there"
+        } else {
+            ""
+        };
+        writeln!(out, "  strip: min |u1| = {u1:.4}{note}")?;
+    }
     writeln!(
         out,
         "  z range ({:.5}, {:.5}) — {}",

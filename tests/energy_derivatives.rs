@@ -2,19 +2,23 @@
 //! term and of the total, on random non-planar configurations.
 
 use knotrod::model::energy::{RodEnergy, Terms};
-use knotrod::model::rod::{Clamps, RodModel, RodState};
+use knotrod::model::rod::{Clamps, Law, RodModel, RodState};
 use nalgebra::Vector3;
 
 mod common;
 use common::Lcg;
 
 fn random_state(n: usize, seed: u64) -> (RodModel, RodState) {
+    random_state_with(n, seed, Law::Kirchhoff)
+}
+
+fn random_state_with(n: usize, seed: u64, law: Law) -> (RodModel, RodState) {
     let model = RodModel {
         segments: n,
         k2: 2.3,
         k3: 1.7,
         stretching_stiffness: 50.0,
-        law: Default::default(),
+        law,
     };
     let clamps = Clamps::new(0.4, 0.1, 0.37);
     // a non-planar loop with large curvature plus noise
@@ -35,7 +39,12 @@ fn random_state(n: usize, seed: u64) -> (RodModel, RodState) {
     let dq: Vec<f64> = (0..map.len())
         .map(|d| if map.is_translation(d) { 0.01 } else { 0.5 } * rng.next())
         .collect();
-    (model, base.displaced(&map, &dq))
+    let mut state = base.displaced(&map, &dq);
+    if law.constrained() {
+        // multipliers of the augmented Lagrangian, which the energy then is
+        state.multipliers = (0..=n).map(|_| 3.0 * rng.next()).collect();
+    }
+    (model, state)
 }
 
 fn rel(a: &[f64], b: &[f64]) -> f64 {
@@ -50,7 +59,12 @@ fn rel(a: &[f64], b: &[f64]) -> f64 {
 }
 
 fn check(terms: Terms, seed: u64) {
-    let (model, state) = random_state(12, seed);
+    check_law(terms, seed, Law::Kirchhoff, 2e-5)
+}
+
+/// FD check of one law; `hessian_step` is the step of the second differences.
+fn check_law(terms: Terms, seed: u64, law: Law, hessian_step: f64) {
+    let (model, state) = random_state_with(12, seed, law);
     let energy = RodEnergy::with_terms(model, terms);
     let map = energy.map;
     let n = map.len();
@@ -71,7 +85,7 @@ fn check(terms: Terms, seed: u64) {
         dq[d] = -eps;
         g_fd[d] = (ep - e(&dq)) / (2.0 * eps);
     }
-    let eps = 2e-5;
+    let eps = hessian_step;
     let mut h_fd = nalgebra::DMatrix::zeros(n, n);
     for a in 0..n {
         for b in a..n {
@@ -128,6 +142,71 @@ fn total_derivatives_match_finite_differences() {
 }
 
 #[test]
+fn strip_derivatives_match_finite_differences() {
+    // Sadowsky law plus the augmented-Lagrangian terms λ κ2 + ρ/2 κ2², with
+    // regularisations comparable to the curvatures so that it is exercised.
+    // With ε = 0.05 the energy is sharp: the second differences need a finer
+    // step (their error was measured to fall as step², 2.6e-5 → 4.1e-7 from
+    // 4e-5 to 5e-6: truncation, not the AD derivatives).
+    for (seed, eps, step) in [(2, 1.0, 2e-5), (3, 5.0, 2e-5), (1, 0.05, 5e-6)] {
+        check_law(
+            Terms::ALL,
+            seed,
+            Law::Strip {
+                regularisation: eps,
+            },
+            step,
+        );
+    }
+}
+
+#[test]
+fn unbendable_derivatives_match_finite_differences() {
+    for seed in 1..3 {
+        check_law(Terms::ALL, seed, Law::Unbendable, 2e-5);
+    }
+}
+
+#[test]
+fn constraint_gradient_matches_finite_differences() {
+    let (model, state) = random_state_with(
+        12,
+        5,
+        Law::Strip {
+            regularisation: 0.05,
+        },
+    );
+    let energy = RodEnergy::new(model);
+    let map = energy.map;
+    let n = map.len();
+    let rows = energy.constraint_rows(&state);
+    let eps = 1e-6;
+    let mut largest = 0.0f64;
+    for d in 0..n {
+        let mut dq = vec![0.0; n];
+        dq[d] = eps;
+        let plus = energy.constraint_rows(&state.displaced(&map, &dq));
+        dq[d] = -eps;
+        let minus = energy.constraint_rows(&state.displaced(&map, &dq));
+        for (i, row) in rows.iter().enumerate() {
+            let fd = (plus[i].0 - minus[i].0) / (2.0 * eps);
+            let exact = map
+                .vertex_stencil(i + 1)
+                .iter()
+                .position(|s| *s == Some(d))
+                .map_or(0.0, |a| row.1[a]);
+            assert!(
+                (fd - exact).abs() < 1e-6 * (1.0 + exact.abs()),
+                "∂κ2_{}/∂q_{d}: {fd} vs {exact}",
+                i + 1
+            );
+            largest = largest.max(exact.abs());
+        }
+    }
+    assert!(largest > 0.1, "the constraint depends on the dofs");
+}
+
+#[test]
 fn hessian_is_symmetric_and_full_gradient_agrees() {
     let (model, state) = random_state(10, 7);
     let energy = RodEnergy::new(model);
@@ -174,8 +253,19 @@ fn moved(
 
 #[test]
 fn parameter_derivative_of_the_gradient_matches_finite_differences() {
+    for law in [
+        Law::Kirchhoff,
+        Law::Strip {
+            regularisation: 0.05,
+        },
+    ] {
+        parameter_derivative_of_the_gradient(law);
+    }
+}
+
+fn parameter_derivative_of_the_gradient(law: Law) {
     use knotrod::model::rod::Parameter;
-    let (model, state) = random_state(12, 5);
+    let (model, state) = random_state_with(12, 5, law);
     let energy = RodEnergy::new(model);
     let map = energy.map;
     let n = map.len();
@@ -205,5 +295,36 @@ fn parameter_derivative_of_the_gradient_matches_finite_differences() {
             exact.iter().any(|v| v.abs() > 1e-3),
             "{p:?}: derivative vanishes"
         );
+    }
+}
+
+#[test]
+fn parameter_derivative_of_the_constraints_matches_finite_differences() {
+    use knotrod::model::rod::Parameter;
+    let (model, state) = random_state_with(
+        12,
+        6,
+        Law::Strip {
+            regularisation: 0.05,
+        },
+    );
+    let energy = RodEnergy::new(model);
+    let map = energy.map;
+    let zero = vec![0.0; map.len()];
+    let rows = energy.constraint_rows(&state);
+    for p in [Parameter::ZStar, Parameter::Delta, Parameter::Phi] {
+        let mut exact = vec![0.0; rows.len()];
+        energy.constraint_parameter_derivative(&rows, &p.velocity(&state.clamps), &mut exact);
+        let v0 = p.value(&state.clamps);
+        let eps = 1e-6;
+        let plus = energy.constraint_rows(&moved(&state, p, v0 + eps, &zero, &map));
+        let minus = energy.constraint_rows(&moved(&state, p, v0 - eps, &zero, &map));
+        let fd: Vec<f64> = plus
+            .iter()
+            .zip(&minus)
+            .map(|(a, b)| (a.0 - b.0) / (2.0 * eps))
+            .collect();
+        let e = rel(&fd, &exact);
+        assert!(e < 1e-6, "{p:?}: relative error {e:e}");
     }
 }

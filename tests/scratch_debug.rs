@@ -8,7 +8,15 @@ fn debug_unstable_strip() {
     let text = std::fs::read_to_string("/tmp/try/strip_cont.json").unwrap();
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let eqs: Vec<Equilibrium> = serde_json::from_value(v["equilibria"].clone()).unwrap();
-    let model = RodModel { segments: 100, k2: 3.0, k3: 3.0, stretching_stiffness: 640000.0, law: Law::Strip { regularisation: 0.05 } };
+    let model = RodModel {
+        segments: 100,
+        k2: 3.0,
+        k3: 3.0,
+        stretching_stiffness: 640000.0,
+        law: Law::Strip {
+            regularisation: 0.05,
+        },
+    };
     let energy = RodEnergy::new(model);
     for e in eqs.iter().step_by(20) {
         let n = energy.map.len();
@@ -20,6 +28,13 @@ fn debug_unstable_strip() {
         ev.sort_by(|a, b| a.total_cmp(b));
         let mut ldlt = knotrod::solve::sparse::Ldlt::new(&energy.pattern);
         let sp = lowest_eigenvalues(&energy.pattern, &vals, None, 2, &mut ldlt).unwrap();
-        println!("φ {:.4} neg {} dense {:?} sparse {:?} gnorm {:.2e}", e.phi_over_2pi, e.negative_eigenvalues, &ev[..3], sp.values, g.iter().map(|x| x*x).sum::<f64>().sqrt());
+        println!(
+            "φ {:.4} neg {} dense {:?} sparse {:?} gnorm {:.2e}",
+            e.phi_over_2pi,
+            e.negative_eigenvalues,
+            &ev[..3],
+            sp.values,
+            g.iter().map(|x| x * x).sum::<f64>().sqrt()
+        );
     }
 }

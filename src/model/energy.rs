@@ -200,6 +200,17 @@ fn material_curvatures<T: Scalar>(g: &VertexGeometry<T>, q: &[T]) -> (T, T) {
     )
 }
 
+/// Material curvatures and twist rate (u1, u2, u3) at vertex i.
+pub fn vertex_strains(state: &RodState, i: usize) -> [f64; 3] {
+    let c = VertexFrames::at(state, i);
+    let q = vertex_variables(state, i);
+    let g = vertex_geometry(&q, &c);
+    let (k1, k2) = material_curvatures(&g, &q);
+    let m = twist_from(&g, &q, &c);
+    let h = 1.0 / state.segments() as f64;
+    [k1 / h, k2 / h, m / h]
+}
+
 /// Integrated curvature κ2 = h u2 about d2 at one vertex: the strip's
 /// constraint function (u2 = 0).
 pub fn normal_curvature<T: Scalar>(q: &[T], c: &VertexFrames) -> T {
@@ -348,10 +359,8 @@ impl RodEnergy {
             .map(|i| {
                 let c = VertexFrames::at(state, i);
                 let q = SVector::<f64, 8>::from(vertex_variables(state, i));
-                let (v, g8) = num_dual::gradient(
-                    |v: SVector<_, 8>| normal_curvature(v.as_slice(), &c),
-                    &q,
-                );
+                let (v, g8) =
+                    num_dual::gradient(|v: SVector<_, 8>| normal_curvature(v.as_slice(), &c), &q);
                 let mut g = [0.0; 11];
                 for (a, ga) in g.iter_mut().enumerate() {
                     for &(k, alpha) in vertex_chain(a).iter().filter(|c| c.0 != usize::MAX) {

@@ -71,6 +71,17 @@ impl RodModel {
         1.0 / self.segments as f64
     }
 
+    /// One line naming the law and its stiffness ratios.
+    pub fn describe(&self) -> String {
+        match self.law {
+            Law::Kirchhoff => format!("Kirchhoff rod, K2 = {}, K3 = {}", self.k2, self.k3),
+            Law::Unbendable => format!("Kirchhoff rod with u2 = 0 (K2 → ∞), K3 = {}", self.k3),
+            Law::Strip { regularisation } => {
+                format!("elastic strip (Sadowsky, u2 = 0), ε = {regularisation}")
+            }
+        }
+    }
+
     /// Stretching stiffness of a solid circular rod of the given diameter: 16/d².
     pub fn circular_stretching_stiffness(diameter: f64) -> f64 {
         16.0 / (diameter * diameter)

@@ -158,7 +158,12 @@ impl<'a> Tracer<'a> {
     /// Apply a step (dofs, then multipliers) and move the clamps.
     fn step_into(&self, from: &RodState, dq: &[f64], p: f64, next: &mut RodState) {
         let map = self.newton.energy.map;
-        from.move_into(&map, &dq[..self.dofs], self.parameter.with(&from.clamps, p), next);
+        from.move_into(
+            &map,
+            &dq[..self.dofs],
+            self.parameter.with(&from.clamps, p),
+            next,
+        );
         if self.kkt.is_some() {
             for (l, d) in next.multipliers[1..].iter_mut().zip(&dq[self.dofs..]) {
                 *l += d;
@@ -295,9 +300,8 @@ impl<'a> Tracer<'a> {
                     negative_count,
                     iterations: it,
                     residual: rel,
-                    correction: (self.weight * self.dot_q(&offset, &offset)
-                        + (p - p_pred).powi(2))
-                    .sqrt()
+                    correction: (self.weight * self.dot_q(&offset, &offset) + (p - p_pred).powi(2))
+                        .sqrt()
                         / sigma.abs().max(1e-300),
                 });
             }

@@ -46,7 +46,14 @@ impl Kkt {
         let pattern = SymmetricPattern::from_stencils(n + m, &stencils);
         // elimination order: each multiplier after the last dof of its stencil
         let last: Vec<usize> = (1..=m)
-            .map(|i| map.vertex_stencil(i).iter().flatten().copied().max().unwrap_or(0))
+            .map(|i| {
+                map.vertex_stencil(i)
+                    .iter()
+                    .flatten()
+                    .copied()
+                    .max()
+                    .unwrap_or(0)
+            })
             .collect();
         let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
         for (r, &d) in last.iter().enumerate() {

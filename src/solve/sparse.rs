@@ -181,7 +181,12 @@ impl Ldlt {
                     inv[o] = k;
                 }
                 let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
-                factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Custom(perm), params)
+                factorize_symbolic_cholesky(
+                    sym,
+                    Side::Upper,
+                    SymmetricOrdering::Custom(perm),
+                    params,
+                )
             }
         }
         .expect("symbolic Cholesky of a valid pattern");

@@ -125,7 +125,10 @@ pub fn minimize(
     let mut jtc = vec![0.0; n];
     let mut jacobian = ConstraintMatrix::new(newton);
     let p_pattern = &newton.energy.pattern.matrix;
-    let (p_colptr, p_rowval) = (p_pattern.col_offsets().to_vec(), p_pattern.row_indices().to_vec());
+    let (p_colptr, p_rowval) = (
+        p_pattern.col_offsets().to_vec(),
+        p_pattern.row_indices().to_vec(),
+    );
     let mut solver: Option<DefaultSolver<f64>> = None;
     let mut report = NewtonReport::start();
     let mut trial = state.clone();
@@ -137,7 +140,11 @@ pub fn minimize(
         jacobian.fill(&rows);
         // Lagrangian gradient ∇E + Jᵀλ = ∇(augmented) − ρ Jᵀc
         jacobian.transpose_mul(&c, &mut jtc);
-        let lagrangian: Vec<f64> = grad.iter().zip(&jtc).map(|(g, j)| g - penalty * j).collect();
+        let lagrangian: Vec<f64> = grad
+            .iter()
+            .zip(&jtc)
+            .map(|(g, j)| g - penalty * j)
+            .collect();
         let gnorm = lagrangian.iter().map(|x| x * x).sum::<f64>().sqrt();
         let max_diag = newton
             .energy
