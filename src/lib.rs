@@ -2,6 +2,7 @@
 //! (discrete elastic rods), after "Stable elastic knots with no self-contact".
 
 pub mod analytic;
+pub mod asymptotics;
 pub mod bench;
 pub mod branch;
 pub mod cli;

@@ -249,3 +249,36 @@ fn figure_8_strip_branches_at_n_100() {
         "good knots at z* = 0.215: {good:?}"
     );
 }
+
+#[test]
+fn one_contact_curves_approach_the_asymptotics() {
+    use knotrod::asymptotics::{curve_i, curve_ii, one_contact_shifts};
+    // along Δφ = 0.8 z* → 0 (β fixed): δ_I's relative error is O(z*²) (the
+    // expansion is to second order), δ_II's is O(z*) (leading order only)
+    let mut errors = Vec::new();
+    for z in [0.08, 0.04, 0.02] {
+        let dphi = 0.8 * z;
+        let (d2, d1) = one_contact_shifts(200, z, dphi).unwrap();
+        let e1 = (d1 - curve_i(z, dphi)) / curve_i(z, dphi);
+        let e2 = (d2 - curve_ii(z, dphi)) / curve_ii(z, dphi);
+        errors.push((e1, e2));
+    }
+    let (i, ii): (Vec<f64>, Vec<f64>) = errors.iter().copied().unzip();
+    assert!(i[0].abs() < 0.05 && i[2].abs() < 0.005, "curve I: {i:?}");
+    assert!(
+        i[1].abs() < i[0].abs() / 3.0,
+        "curve I error falls faster than z*: {i:?}"
+    );
+    for w in ii.windows(2) {
+        let ratio = w[1] / w[0];
+        assert!((0.4..0.7).contains(&ratio), "curve II error ∝ z*: {ii:?}");
+    }
+}
+
+#[test]
+fn one_contact_curve_reaches_the_self_contacting_elastica() {
+    // as δ → 0 the largest z* on the one-contact curve tends to 0.223, the end
+    // distance of the self-contacting planar elastica (paper eqs. 6.19–6.20)
+    let z = knotrod::asymptotics::max_one_contact_z_star(100, 0.001, 0.002).unwrap();
+    assert!((z - 0.223).abs() < 0.01, "max z* = {z}");
+}

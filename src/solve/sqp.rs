@@ -238,7 +238,10 @@ pub fn minimize(
                 }
                 kkt.ldlt.solve_in_place(&mut r);
                 d.iter_mut().zip(&r[..n]).for_each(|(x, y)| *x += y);
-                new_lambda.iter_mut().zip(&r[n..]).for_each(|(x, y)| *x += y);
+                new_lambda
+                    .iter_mut()
+                    .zip(&r[n..])
+                    .for_each(|(x, y)| *x += y);
             }
         }
         let mut step = d;
