@@ -3,7 +3,7 @@
 //! points (S), walls touched (W), self-crossings (X) and knot changes — and the
 //! bifurcating branches followed from branch points when asked.
 
-use crate::equilibrium::{Equilibrium, Measure, Shape, analyse};
+use crate::equilibrium::{Equilibrium, Measure, Shape, analyse_from};
 use crate::model::rod::{Parameter, RodState};
 use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
 use crate::solve::newton::{Newton, NewtonReport};
@@ -92,6 +92,8 @@ pub struct BranchRun<'a, 'r> {
     /// Branch points found (point, null vector), to switch onto.
     branch_points: Vec<(Point, Vec<f64>, usize)>,
     next_branch: usize,
+    /// The last measured equilibrium (writhe and knot type carry over from it).
+    previous: Option<Equilibrium>,
 }
 
 fn event(kind: &str, p: &Point, branch: usize, detail: String) -> Event {
@@ -123,6 +125,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             events: Vec::new(),
             branch_points: Vec::new(),
             next_branch: first_branch,
+            previous: None,
         }
     }
 
@@ -136,9 +139,16 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             energy,
             factorizations: 0,
         };
-        let mut eq = analyse(self.tracer.newton, &p.state, &report, &self.options.measure)?;
+        let mut eq = analyse_from(
+            self.tracer.newton,
+            &p.state,
+            &report,
+            &self.options.measure,
+            self.previous.as_ref(),
+        )?;
         eq.branch = branch;
         eq.leg = leg;
+        self.previous = Some(eq.clone());
         Ok(eq)
     }
 

@@ -554,16 +554,65 @@ fn map_command(
         .map
         .clone()
         .context("the scene has no [map] section")?;
-    let cont = scene
-        .continuation
-        .as_ref()
-        .context("the scene has no [continuation] section")?;
     let name = scene.name.clone().unwrap_or_else(|| "map".into());
     let json = json.unwrap_or_else(|| PathBuf::from("recordings").join(format!("{name}.map.json")));
     let shard = match shard {
         Some(s) => Some(crate::map::parse_shard(s)?),
         None => None,
     };
+    let Some(slices) = spec.slices.clone() else {
+        return map_plane(&scene, &name, &json, shard, segments).map(|_| ());
+    };
+    // a 3D map: one plane map per slice, each with its own file and cache
+    let mut maps = Vec::new();
+    for (k, v) in slices.values.iter().enumerate() {
+        let slice = slices.scene(&scene, k);
+        let stem = json.file_stem().and_then(|s| s.to_str()).unwrap_or("map");
+        let file = json.with_file_name(format!("{stem}_slice{k}.json"));
+        writeln!(
+            std::io::stdout().lock(),
+            "slice {k}: {} = {v}",
+            slices.parameter.name()
+        )?;
+        if let Some(m) = map_plane(&slice, &format!("{name} ({} = {v})", slices.parameter.name()), &file, shard, segments)? {
+            maps.push(m);
+        }
+    }
+    if shard.is_some() {
+        return Ok(());
+    }
+    let map3 = crate::map::assemble_3d(&name, &slices, maps);
+    std::fs::write(&json, serde_json::to_string_pretty(&map3)? + "\n")
+        .with_context(|| format!("writing {}", json.display()))?;
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "3D map of {name}: good volume {:.6}", map3.good_volume)?;
+    for (k, v) in &map3.bounding_box {
+        writeln!(out, "  good knots for {k} in [{:.5}, {:.5}]", v[0], v[1])?;
+    }
+    for (v, a) in map3.slice_values.iter().zip(&map3.slice_areas) {
+        writeln!(out, "  {} = {v}: good area {a:.6}", map3.slice_parameter)?;
+    }
+    for p in crate::plot::island_slices(&json.with_extension(""), &map3)? {
+        writeln!(out, "plot written to {}", p.display())?;
+    }
+    writeln!(out, "3D map written to {}", json.display())?;
+    Ok(())
+}
+
+/// One plane of a map (or one shard of it): returns the assembled map when
+/// the whole plane was computed.
+fn map_plane(
+    scene: &Scene,
+    name: &str,
+    json: &Path,
+    shard: Option<(usize, usize)>,
+    segments: Option<usize>,
+) -> Result<Option<crate::map::Map>> {
+    let spec = scene.map.clone().context("the scene has no [map] section")?;
+    let cont = scene
+        .continuation
+        .as_ref()
+        .context("the scene has no [continuation] section")?;
     let indices = match shard {
         Some(sh) => crate::map::shard_lines(&spec, sh),
         None => (0..spec.lines).collect(),
@@ -575,7 +624,7 @@ fn map_command(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} lines, ETA {eta} — {msg}")
             .unwrap(),
     );
-    let lines = crate::map::compute_lines(&scene, &spec, &indices, segments, &cache, &|l| {
+    let lines = crate::map::compute_lines(scene, &spec, &indices, segments, &cache, &|l| {
         progress.inc(1);
         progress.set_message(format!(
             "{} = {:.4}: {} good intervals",
@@ -588,13 +637,13 @@ fn map_command(
     match shard {
         Some(sh) => {
             let part = crate::map::Partial {
-                scene: name,
+                scene: name.to_string(),
                 spec,
                 phi_range: cont.range,
                 shard: sh,
                 lines,
             };
-            std::fs::write(&json, serde_json::to_string_pretty(&part)? + "\n")
+            std::fs::write(json, serde_json::to_string_pretty(&part)? + "\n")
                 .with_context(|| format!("writing {}", json.display()))?;
             writeln!(
                 std::io::stdout().lock(),
@@ -603,11 +652,12 @@ fn map_command(
                 sh.1,
                 json.display()
             )?;
-            Ok(())
+            Ok(None)
         }
-        None => write_map(
-            &crate::map::assemble(&name, &spec, cont.range, lines),
-            &json,
-        ),
+        None => {
+            let map = crate::map::assemble(name, &spec, cont.range, lines);
+            write_map(&map, json)?;
+            Ok(Some(map))
+        }
     }
 }

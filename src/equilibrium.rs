@@ -237,12 +237,26 @@ pub struct Shape {
 impl Shape {
     /// Measure the centreline of `state`.
     pub fn of(state: &RodState, measure: &Measure) -> Shape {
+        Self::measure(state, measure, None)
+    }
+
+    /// Measure `state`, reached from the measured equilibrium `previous`
+    /// (e.g. the last point of a branch). When no strand can have passed
+    /// through another or through a ray on the way — every clearance, before
+    /// and after, exceeds twice the largest node move — the ray-closed
+    /// ribbon's link keeps its integer part (Călugăreanu–White: Lk = Tw + Wr
+    /// = n + φ/2π), so Wr = n + φ/2π − Tw in O(N), and the knot type is
+    /// unchanged. Otherwise both are computed afresh (O(N²)).
+    pub fn continued(state: &RodState, measure: &Measure, previous: &Equilibrium) -> Shape {
+        Self::measure(state, measure, Some(previous))
+    }
+
+    fn measure(state: &RodState, measure: &Measure, previous: Option<&Equilibrium>) -> Shape {
         let (points, arc) = state.centreline();
         let e3 = Vector3::z();
-        let writhe = writhe_closed(&ray_closure(&points, -e3, e3, measure.ray_length));
-        // the knot type needs the rays only to leave the curve's neighbourhood
+        // the knot type and ray distances need the rays only to leave the
+        // curve's neighbourhood
         let reach = 2.0 * extent(&points) + 1.0;
-        let knot = knot_type(&ray_closure(&points, -e3, e3, reach));
         let self_approach = min_self_distance(&points, &arc, measure.self_distance_gap);
         let heights: Vec<f64> = points[1..points.len() - 1].iter().map(|p| p.z).collect();
         let wall_distance = wall_clearance(&heights, state.clamps.z_star);
@@ -253,6 +267,51 @@ impl Shape {
                 .map_or(f64::INFINITY, |d| d.0)
         };
         let ray_distance = [ray(&Vector3::zeros(), -e3, 0.0), ray(&end, e3, 1.0)];
+        let self_distance = self_approach.map_or(f64::INFINITY, |a| a.distance);
+        let carried = previous.filter(|p| {
+            if p.state.nodes.len() != state.nodes.len() || p.knot_ambiguous {
+                return false;
+            }
+            let moved = p
+                .state
+                .nodes
+                .iter()
+                .zip(&state.nodes)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max)
+                + (p.state.clamps.end_point() - state.clamps.end_point()).norm();
+            let clearance = [
+                self_distance,
+                ray_distance[0],
+                ray_distance[1],
+                p.min_self_distance,
+                p.ray_distance[0],
+                p.ray_distance[1],
+            ]
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+            clearance > 2.0 * moved
+        });
+        let (writhe, knot) = match carried {
+            Some(p) => {
+                let turns = (p.link - p.phi_over_2pi).round();
+                (
+                    turns + state.clamps.phi_over_2pi() - state.twist(),
+                    KnotType {
+                        determinant: p.knot_determinant,
+                        alexander: p.alexander.clone(),
+                        name: p.knot_name.clone(),
+                        crossings: 0,
+                        directions: 0,
+                        ambiguous: false,
+                    },
+                )
+            }
+            None => (
+                writhe_closed(&ray_closure(&points, -e3, e3, measure.ray_length)),
+                knot_type(&ray_closure(&points, -e3, e3, reach)),
+            ),
+        };
         Shape {
             writhe,
             knot,
@@ -270,6 +329,19 @@ pub fn analyse(
     report: &NewtonReport,
     measure: &Measure,
 ) -> Result<Equilibrium> {
+    analyse_from(newton, state, report, measure, None)
+}
+
+/// As [`analyse`], for a state reached from the measured equilibrium
+/// `previous` (the writhe and knot type are carried over when no strand can
+/// have passed through another: see [`Shape::continued`]).
+pub fn analyse_from(
+    newton: &mut Newton,
+    state: &RodState,
+    report: &NewtonReport,
+    measure: &Measure,
+    previous: Option<&Equilibrium>,
+) -> Result<Equilibrium> {
     let k = measure.eigenvalues;
     let energy: &RodEnergy = &newton.energy;
     let n = energy.map.len();
@@ -285,7 +357,7 @@ pub fn analyse(
     let (min_z, max_z) = state.z_range();
     let z_star = state.clamps.z_star;
     let stable = plain.negative_count == 0 && plain.values.first().is_none_or(|v| *v > 0.0);
-    let shape = Shape::of(state, measure);
+    let shape = Shape::measure(state, measure, previous);
     let twist = state.twist();
     let walled = min_z > 0.0 && max_z < z_star;
     let min_self_distance = shape.self_approach.map_or(f64::INFINITY, |a| a.distance);

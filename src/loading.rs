@@ -5,7 +5,7 @@
 //! the carried state, large change of shape or of link) and recorded.
 
 use crate::branch::{Event, Observer};
-use crate::equilibrium::{Measure, analyse};
+use crate::equilibrium::{Measure, analyse, analyse_from};
 use crate::model::rod::{Clamps, RodState};
 use crate::scene::LoadingSpec;
 use crate::solve::newton::{Newton, NewtonSettings};
@@ -206,7 +206,7 @@ pub fn run_loading(
             };
             let context = || format!("loading leg {leg}, step {k}");
             let mut step = carry(newton, &state, c, settings).with_context(context)?;
-            let mut next = analyse(newton, &step.state, &step.report, measure)?;
+            let mut next = analyse_from(newton, &step.state, &step.report, measure, Some(&eq))?;
             if step.jumped || link_jump(&eq, &next).abs() > JUMP_LINK {
                 // a hand moves slowly: the rod jumps where its branch ends, not
                 // where a finite step happened to overshoot; bisect the step
@@ -214,7 +214,8 @@ pub fn run_loading(
                 while clamp_gap(&lo_state.clamps, &hi) > JUMP_LOCATION {
                     let mid = midpoint(&lo_state.clamps, &hi);
                     let trial = carry(newton, &lo_state, mid, settings).with_context(context)?;
-                    let trial_eq = analyse(newton, &trial.state, &trial.report, measure)?;
+                    let trial_eq =
+                        analyse_from(newton, &trial.state, &trial.report, measure, Some(&lo_eq))?;
                     if trial.jumped || link_jump(&lo_eq, &trial_eq).abs() > JUMP_LINK {
                         hi = mid;
                     } else {
@@ -224,7 +225,8 @@ pub fn run_loading(
                 // the last step from the end of the branch jumps; the rod then
                 // moves on from where it landed to this step's clamps
                 let landed = carry(newton, &lo_state, hi, settings).with_context(context)?;
-                let landed_eq = analyse(newton, &landed.state, &landed.report, measure)?;
+                let landed_eq =
+                    analyse_from(newton, &landed.state, &landed.report, measure, Some(&lo_eq))?;
                 let jump_link = link_jump(&lo_eq, &landed_eq);
                 if landed.jumped || jump_link.abs() > JUMP_LINK {
                     events.push(Event {
@@ -244,7 +246,13 @@ pub fn run_loading(
                         ),
                     });
                     step = carry(newton, &landed.state, c, settings).with_context(context)?;
-                    next = analyse(newton, &step.state, &step.report, measure)?;
+                    next = analyse_from(
+                        newton,
+                        &step.state,
+                        &step.report,
+                        measure,
+                        Some(&landed_eq),
+                    )?;
                 }
             }
             observer(next.clone())?;

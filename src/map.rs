@@ -129,6 +129,102 @@ pub struct MapSpec {
     /// Columns of the classified grid.
     #[serde(default = "default_columns")]
     pub grid_columns: usize,
+    /// A 3D map: one such map per value of a third parameter.
+    #[serde(default)]
+    pub slices: Option<SliceSpec>,
+}
+
+/// `[map.slices]`: the slices of a 3D map (e.g. δ for Figure 9).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SliceSpec {
+    /// The slicing parameter (default delta).
+    #[serde(default = "default_slicing")]
+    pub parameter: Parameter,
+    /// Its values, increasing.
+    pub values: Vec<f64>,
+    /// φ/2π of each slice's starting equilibrium (default: the scene's).
+    #[serde(default)]
+    pub start_phi_over_2pi: Option<Vec<f64>>,
+}
+
+fn default_slicing() -> Parameter {
+    Parameter::Delta
+}
+
+impl SliceSpec {
+    /// The scene of slice k: its parameter set, its start φ.
+    pub fn scene(&self, scene: &Scene, k: usize) -> Scene {
+        let mut s = scene.clone();
+        let c = self.parameter.with(&scene.clamps(), self.values[k]);
+        s.clamps.z_star = c.z_star;
+        s.clamps.delta = c.delta;
+        s.clamps.phi_over_2pi = c.phi_over_2pi();
+        if let Some(p) = &self.start_phi_over_2pi {
+            s.clamps.phi_over_2pi = p[k];
+        }
+        if let Some(m) = s.map.as_mut() {
+            m.slices = None;
+        }
+        s
+    }
+}
+
+/// A 3D map: its slices and the good region's volume and bounding box.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Map3 {
+    /// Scene name.
+    pub scene: String,
+    /// The slicing parameter.
+    pub slice_parameter: String,
+    /// The swept parameter of each slice.
+    pub parameter: String,
+    /// Slice values.
+    pub slice_values: Vec<f64>,
+    /// Good area of each slice.
+    pub slice_areas: Vec<f64>,
+    /// Volume of the good region in (slice, swept, φ/2π) (trapezoids across
+    /// the slices).
+    pub good_volume: f64,
+    /// Bounding box of the good region over all slices.
+    pub bounding_box: BTreeMap<String, [f64; 2]>,
+    /// The slices' maps.
+    pub slices: Vec<Map>,
+}
+
+/// Join slice maps into a 3D map.
+pub fn assemble_3d(scene: &str, spec: &SliceSpec, slices: Vec<Map>) -> Map3 {
+    let areas: Vec<f64> = slices.iter().map(|m| m.good_area).collect();
+    let volume = spec
+        .values
+        .windows(2)
+        .zip(areas.windows(2))
+        .map(|(v, a)| 0.5 * (a[0] + a[1]) * (v[1] - v[0]))
+        .sum();
+    let mut bounding_box: BTreeMap<String, [f64; 2]> = BTreeMap::new();
+    for (m, &v) in slices.iter().zip(&spec.values) {
+        if m.bounding_box.is_empty() {
+            continue;
+        }
+        let mut grow = |k: &str, r: [f64; 2]| {
+            let e = bounding_box.entry(k.to_string()).or_insert(r);
+            *e = [e[0].min(r[0]), e[1].max(r[1])];
+        };
+        grow(spec.parameter.name(), [v, v]);
+        for (k, r) in &m.bounding_box {
+            grow(k, *r);
+        }
+    }
+    Map3 {
+        scene: scene.into(),
+        slice_parameter: spec.parameter.name().into(),
+        parameter: slices.first().map(|m| m.parameter.clone()).unwrap_or_default(),
+        slice_values: spec.values.clone(),
+        slice_areas: areas,
+        good_volume: volume,
+        bounding_box,
+        slices,
+    }
 }
 
 fn default_sweep() -> Parameter {
@@ -375,7 +471,7 @@ pub fn assemble(
         })
         .collect();
     let grid = lines.iter().map(|l| grid_row(l, &grid_phi)).collect();
-    let mut boundaries: BTreeMap<String, Vec<[f64; 2]>> = BTreeMap::new();
+    let mut ends: Vec<(usize, f64, f64, String)> = Vec::new();
     let mut area = 0.0;
     let (mut vlo, mut vhi, mut plo, mut phi_hi) = (
         f64::INFINITY,
@@ -389,14 +485,8 @@ pub fn assemble(
         .collect();
     for (k, l) in lines.iter().enumerate() {
         for i in &l.intervals {
-            boundaries
-                .entry(i.lo_label.clone())
-                .or_default()
-                .push([l.value, i.lo]);
-            boundaries
-                .entry(i.hi_label.clone())
-                .or_default()
-                .push([l.value, i.hi]);
+            ends.push((k, l.value, i.lo, format!("{}/lo", i.lo_label)));
+            ends.push((k, l.value, i.hi, format!("{}/hi", i.hi_label)));
             vlo = vlo.min(l.value);
             vhi = vhi.max(l.value);
             plo = plo.min(i.lo);
@@ -406,6 +496,7 @@ pub fn assemble(
             area += 0.5 * (widths[k] + widths[k - 1]) * (l.value - lines[k - 1].value);
         }
     }
+    let boundaries = chain_boundaries(&ends);
     let mut bounding_box = BTreeMap::new();
     if vlo.is_finite() {
         bounding_box.insert(spec.parameter.name().to_string(), [vlo, vhi]);
@@ -421,6 +512,51 @@ pub fn assemble(
         good_area: area,
         bounding_box,
     }
+}
+
+/// Join interval ends (line index, parameter, φ/2π, "label/side") into
+/// boundary curves: an end continues the curve of the same label and side
+/// whose last end lies on the previous line and is nearest in φ (within
+/// 0.05); otherwise it starts a new curve. A label with several curves is
+/// numbered along φ (X1, X2, … as in the paper).
+fn chain_boundaries(ends: &[(usize, f64, f64, String)]) -> BTreeMap<String, Vec<[f64; 2]>> {
+    let mut curves: Vec<(String, usize, Vec<[f64; 2]>)> = Vec::new(); // key, last line, points
+    let mut sorted: Vec<&(usize, f64, f64, String)> = ends.iter().collect();
+    sorted.sort_by(|a, b| (a.0, &a.3).cmp(&(b.0, &b.3)).then(a.2.total_cmp(&b.2)));
+    for &(line, value, phi, ref key) in sorted {
+        let best = curves
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| &c.0 == key && c.1 + 1 == line)
+            .map(|(i, c)| (i, (c.2.last().unwrap()[1] - phi).abs()))
+            .filter(|&(_, d)| d <= 0.05)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        match best {
+            Some((i, _)) => {
+                curves[i].1 = line;
+                curves[i].2.push([value, phi]);
+            }
+            None => curves.push((key.clone(), line, vec![[value, phi]])),
+        }
+    }
+    let mut named: BTreeMap<String, Vec<Vec<[f64; 2]>>> = BTreeMap::new();
+    for (key, _, points) in curves {
+        let label = key.split('/').next().unwrap_or("?").to_string();
+        named.entry(label).or_default().push(points);
+    }
+    let mut out = BTreeMap::new();
+    for (label, mut list) in named {
+        if list.len() == 1 {
+            out.insert(label, list.pop().unwrap());
+            continue;
+        }
+        let mean = |c: &Vec<[f64; 2]>| c.iter().map(|p| p[1]).sum::<f64>() / c.len() as f64;
+        list.sort_by(|a, b| mean(a).total_cmp(&mean(b)));
+        for (k, c) in list.into_iter().enumerate() {
+            out.insert(format!("{label}{}", k + 1), c);
+        }
+    }
+    out
 }
 
 /// Class of a line at each grid φ: the stable state if several, else the first.

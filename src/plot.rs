@@ -314,6 +314,37 @@ pub fn island_map(stem: &Path, map: &crate::map::Map) -> Result<Vec<std::path::P
     Ok(written)
 }
 
+/// A 3D map as stacked slices, one panel each (SVG, and PNG when a font is
+/// available).
+pub fn island_slices(stem: &Path, map: &crate::map::Map3) -> Result<Vec<std::path::PathBuf>> {
+    let n = map.slices.len().max(1);
+    let cols = n.min(4);
+    let rows = n.div_ceil(cols);
+    let size = (450 * cols as u32, 380 * rows as u32);
+    let mut written = Vec::new();
+    let svg = stem.with_extension("svg");
+    {
+        let root = SVGBackend::new(&svg, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e:?}"))?;
+        for (area, m) in root.split_evenly((rows, cols)).into_iter().zip(&map.slices) {
+            draw_map(area, m)?;
+        }
+    }
+    written.push(svg);
+    if font_available() {
+        let png = stem.with_extension("png");
+        {
+            let root = BitMapBackend::new(&png, size).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| anyhow!("plot: {e:?}"))?;
+            for (area, m) in root.split_evenly((rows, cols)).into_iter().zip(&map.slices) {
+                draw_map(area, m)?;
+            }
+        }
+        written.push(png);
+    }
+    Ok(written)
+}
+
 fn draw_map<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, map: &crate::map::Map) -> Result<()>
 where
     DB::ErrorType: 'static,

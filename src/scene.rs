@@ -590,6 +590,28 @@ impl Scene {
             if m.grid_columns < 2 {
                 return Err(invalid("map.grid_columns", "must be >= 2"));
             }
+            if let Some(sl) = &m.slices {
+                if sl.values.is_empty() || sl.values.iter().any(|v| !v.is_finite()) {
+                    return Err(invalid("map.slices.values", "must be finite and non-empty"));
+                }
+                if sl.values.windows(2).any(|w| w[1] <= w[0]) {
+                    return Err(invalid("map.slices.values", "must be increasing"));
+                }
+                if sl.parameter == m.parameter || Some(sl.parameter) == self.continuation.as_ref().map(|c| c.parameter) {
+                    return Err(invalid(
+                        "map.slices.parameter",
+                        "must differ from map.parameter and continuation.parameter",
+                    ));
+                }
+                if let Some(p) = &sl.start_phi_over_2pi
+                    && p.len() != sl.values.len()
+                {
+                    return Err(invalid(
+                        "map.slices.start_phi_over_2pi",
+                        "needs one value per slice",
+                    ));
+                }
+            }
         }
         let d = &self.diagnostics;
         positive("diagnostics.self_distance_gap", d.self_distance_gap)?;

@@ -79,3 +79,34 @@ fn self_distance_matches_brute_force_on_random_curves() {
         }
     }
 }
+
+#[test]
+fn writhe_carried_along_a_branch_equals_the_full_writhe() {
+    // Figure 3's branch at N = 100: every accepted point's writhe was carried
+    // over from the previous one (Lk = n + φ/2π) unless a strand came near
+    // another; recompute each from scratch and compare
+    use knotrod::equilibrium::{Measure, Shape};
+    let text = std::fs::read_to_string("scenes/fig3_kirchhoff.toml").unwrap();
+    let text = text.replace("segments = 200", "segments = 100");
+    let text = text.split("[output]").next().unwrap();
+    let mut scene = knotrod::scene::Scene::parse(text).unwrap();
+    if let Some(c) = scene.continuation.as_mut() {
+        c.switch_branches = false;
+    }
+    let mut eqs = Vec::new();
+    knotrod::run::run_scene(&scene, None, &mut |e| {
+        eqs.push(e);
+        Ok(())
+    })
+    .unwrap();
+    assert!(eqs.len() > 50);
+    let measure = Measure::of(&scene);
+    let mut largest = 0.0f64;
+    for e in &eqs {
+        let full = Shape::of(&e.state, &measure);
+        largest = largest.max((full.writhe - e.writhe).abs());
+        assert_eq!(full.knot.determinant, e.knot_determinant, "at φ/2π = {}", e.phi_over_2pi);
+    }
+    // the full writhe closes the rays at length 1e6: it differs by O(1e-6)
+    assert!(largest < 1e-5, "largest writhe difference {largest:e}");
+}

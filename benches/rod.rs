@@ -1,0 +1,129 @@
+//! Cost of the rod's per-step operations versus N (100 … 3200): energy,
+//! gradient, Hessian assembly, one Newton step (factorisation + solve), the
+//! lowest eigenvalue, the per-step diagnostics (writhe carried along the
+//! branch), one continuation step with full diagnostics; and the Figure 3
+//! branch end to end at N = 200.
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use knotrod::equilibrium::{Measure, Shape, analyse, solve_scene};
+use knotrod::model::energy::RodEnergy;
+use knotrod::model::rod::Parameter;
+use knotrod::scene::Scene;
+use knotrod::solve::continuation::{ContinuationSettings, Tracer};
+use knotrod::solve::newton::Newton;
+use knotrod::solve::sparse::Ldlt;
+use knotrod::stability::lowest_eigenvalues;
+use std::path::Path;
+
+const SIZES: [usize; 6] = [100, 200, 400, 800, 1600, 3200];
+
+fn bench(c: &mut Criterion) {
+    let d = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
+    let measure = Measure {
+        eigenvalues: 1,
+        ..Measure::of(&d)
+    };
+    let solved: Vec<_> = SIZES
+        .iter()
+        .map(|&n| (n, solve_scene(&d, Some(n)).unwrap()))
+        .collect();
+    let mut group = |name: &str, f: &dyn Fn(usize, &knotrod::equilibrium::Equilibrium) -> Box<dyn FnMut()>| {
+        let mut g = c.benchmark_group(name);
+        g.sample_size(10);
+        for (n, eq) in &solved {
+            let mut run = f(*n, eq);
+            g.bench_with_input(BenchmarkId::from_parameter(n), n, |b, _| b.iter(&mut run));
+        }
+        g.finish();
+    };
+    group("energy", &|n, eq| {
+        let energy = RodEnergy::new(d.rod_model(Some(n)));
+        let state = eq.state.clone();
+        Box::new(move || {
+            energy.energy(&state);
+        })
+    });
+    group("gradient", &|n, eq| {
+        let energy = RodEnergy::new(d.rod_model(Some(n)));
+        let state = eq.state.clone();
+        let mut g = vec![0.0; energy.map.len()];
+        Box::new(move || {
+            energy.gradient(&state, &mut g);
+        })
+    });
+    group("hessian", &|n, eq| {
+        let energy = RodEnergy::new(d.rod_model(Some(n)));
+        let state = eq.state.clone();
+        let mut g = vec![0.0; energy.map.len()];
+        let mut v = vec![0.0; energy.pattern.nnz()];
+        Box::new(move || {
+            energy.hessian(&state, &mut g, &mut v);
+        })
+    });
+    group("newton_step", &|n, eq| {
+        let energy = RodEnergy::new(d.rod_model(Some(n)));
+        let state = eq.state.clone();
+        let mut g = vec![0.0; energy.map.len()];
+        let mut v = vec![0.0; energy.pattern.nnz()];
+        energy.hessian(&state, &mut g, &mut v);
+        let mut ldlt = Ldlt::new(&energy.pattern);
+        Box::new(move || {
+            ldlt.factor(&v).unwrap();
+            let mut x = g.clone();
+            ldlt.solve_in_place(&mut x);
+        })
+    });
+    group("lowest_eigenvalue", &|n, eq| {
+        let energy = RodEnergy::new(d.rod_model(Some(n)));
+        let state = eq.state.clone();
+        let mut g = vec![0.0; energy.map.len()];
+        let mut v = vec![0.0; energy.pattern.nnz()];
+        energy.hessian(&state, &mut g, &mut v);
+        let mut ldlt = Ldlt::new(&energy.pattern);
+        Box::new(move || {
+            lowest_eigenvalues(&energy.pattern, &v, None, 1, &mut ldlt).unwrap();
+        })
+    });
+    group("diagnostics_carried", &|_, eq| {
+        let (state, previous) = (eq.state.clone(), eq.clone());
+        Box::new(move || {
+            Shape::continued(&state, &measure, &previous);
+        })
+    });
+    group("continuation_step", &|n, eq| {
+        let energy = RodEnergy::new(d.rod_model(Some(n)));
+        let mut newton = Newton::new(energy);
+        let state = eq.state.clone();
+        let previous = eq.clone();
+        Box::new(move || {
+            let mut tracer = Tracer::new(&mut newton, Parameter::Phi, ContinuationSettings::default());
+            let a = tracer.start(state.clone(), 1.0).unwrap();
+            let b = tracer.correct(&a, 0.005, None).unwrap();
+            let report = knotrod::solve::newton::NewtonReport {
+                converged: true,
+                iterations: b.iterations,
+                residual_history: vec![],
+                gradient_norm: b.residual,
+                energy: 0.0,
+                factorizations: 0,
+            };
+            drop(tracer);
+            knotrod::equilibrium::analyse_from(&mut newton, &b.state, &report, &measure, Some(&previous))
+                .unwrap();
+        })
+    });
+    let _ = analyse;
+    let mut fig3 = Scene::load(Path::new("scenes/fig3_kirchhoff.toml")).unwrap();
+    if let Some(c) = fig3.continuation.as_mut() {
+        c.switch_branches = false;
+    }
+    let mut g = c.benchmark_group("figure_3_branch");
+    g.sample_size(10);
+    g.bench_function("200", |b| {
+        b.iter(|| knotrod::run::run_scene(&fig3, Some(200), &mut |_| Ok(())).unwrap())
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
