@@ -106,6 +106,7 @@ fn bench(c: &mut Criterion) {
                 gradient_norm: b.residual,
                 energy: 0.0,
                 factorizations: 0,
+                contacts: Vec::new(),
             };
             drop(tracer);
             knotrod::equilibrium::analyse_from(&mut newton, &b.state, &report, &measure, Some(&previous))

@@ -126,7 +126,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
     let mut per: BTreeMap<String, Vec<(usize, f64)>> = BTreeMap::new();
     for n in [200, 400, 800, 1600, 3200] {
         let e = crate::equilibrium::solve_scene(&d, Some(n))?;
-        let state: RodState = e.state;
+        let state: RodState = e.state.clone();
         let energy = RodEnergy::new(d.rod_model(Some(n)));
         let mut g = vec![0.0; energy.map.len()];
         let mut v = vec![0.0; energy.pattern.nnz()];
@@ -166,14 +166,14 @@ pub fn run(scenes: &Path) -> Result<Report> {
         let (p, arc) = state.centreline();
         let closed = ray_closure(&p, -nalgebra::Vector3::z(), nalgebra::Vector3::z(), 1e6);
         push(
-            "writhe",
+            "writhe_at_passages",
             per_call(|| {
                 writhe_closed(&closed);
             }),
         );
         let short = ray_closure(&p, -nalgebra::Vector3::z(), nalgebra::Vector3::z(), 3.0);
         push(
-            "knot_type",
+            "knot_type_at_passages",
             per_call(|| {
                 knot_type(&short);
             }),
@@ -185,8 +185,16 @@ pub fn run(scenes: &Path) -> Result<Report> {
             }),
         );
         let m = Measure::of(&d);
+        // per continuation step: writhe and knot type carried from the
+        // previous point (the full O(N²) ones run only where strands meet)
         push(
-            "diagnostics",
+            "diagnostics_per_step",
+            per_call(|| {
+                Shape::continued(&state, &m, &e);
+            }),
+        );
+        push(
+            "diagnostics_full",
             per_call(|| {
                 Shape::of(&state, &m);
             }),

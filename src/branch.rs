@@ -138,6 +138,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             gradient_norm: p.residual,
             energy,
             factorizations: 0,
+            contacts: Vec::new(),
         };
         let mut eq = analyse_from(
             self.tracer.newton,

@@ -90,6 +90,12 @@ pub struct Equilibrium {
     /// regularisation, not the Sadowsky law, decides its shape there.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub regularised: Option<bool>,
+    /// Contacts (with a `[contact]` model): arc length, obstacle, force.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<crate::solve::sqp::ContactForce>,
+    /// Sum of the contact forces' magnitudes.
+    #[serde(default)]
+    pub contact_force: f64,
     /// Branch this equilibrium lies on (0 for a single solve).
     #[serde(default)]
     pub branch: usize,
@@ -322,6 +328,59 @@ impl Shape {
     }
 }
 
+/// Stability under contact: the Hessian restricted to motions that keep the
+/// active contacts (with a ray or a fixed obstacle) closed, by adding a stiff
+/// penalty ρ ∇g ∇gᵀ for each (like the constrained laws' augmented
+/// Lagrangian; its inertia is that of the restricted Hessian). Self-contacts
+/// couple distant dofs outside the sparse pattern and are not added: with
+/// them, the reported stability is that of the rod free to leave the contact
+/// in that direction only through its neighbours (conservative).
+fn hold_contacts(newton: &Newton, state: &RodState, report: &NewtonReport, values: &mut [f64]) {
+    let Some(model) = &newton.contact else {
+        return;
+    };
+    if report.contacts.is_empty() {
+        return;
+    }
+    let energy = &newton.energy;
+    let max_diag = energy
+        .pattern
+        .diagonal
+        .iter()
+        .map(|&s| values[s].abs())
+        .fold(0.0, f64::max);
+    let rho = 1e3 * max_diag;
+    for g in model.gaps(state) {
+        if matches!(g.obstacle, crate::geometry::contact::Obstacle::SelfAt(_)) {
+            continue;
+        }
+        // a reported contact merges the rows of neighbouring segments
+        let reach = 1.5 * energy.model.segment_length() + 1e-9;
+        let held = g.gap < 1e-6 * model.diameter
+            && report.contacts.iter().any(|c| {
+                c.force > 0.0 && c.obstacle == g.obstacle.name() && (c.s - g.s).abs() <= reach
+            });
+        if !held {
+            continue;
+        }
+        let dofs: Vec<(usize, f64)> = g
+            .gradient
+            .iter()
+            .filter_map(|(k, v)| energy.map.node(*k).map(|d| (d, *v)))
+            .flat_map(|(d, v)| (0..3).map(move |c| (d + c, v[c])))
+            .collect();
+        for &(a, va) in &dofs {
+            for &(b, vb) in &dofs {
+                if a <= b
+                    && let Some(s) = energy.pattern.slot(a, b)
+                {
+                    values[s] += rho * va * vb;
+                }
+            }
+        }
+    }
+}
+
 /// Measure an equilibrium found by `newton` (its energy is reused for the Hessian).
 pub fn analyse(
     newton: &mut Newton,
@@ -348,6 +407,8 @@ pub fn analyse_from(
     let mut grad = vec![0.0; n];
     let mut values = vec![0.0; energy.pattern.nnz()];
     energy.hessian(state, &mut grad, &mut values);
+    hold_contacts(newton, state, report, &mut values);
+    let energy: &RodEnergy = &newton.energy;
     let plain = lowest_eigenvalues(&energy.pattern, &values, None, k, &mut newton.ldlt)
         .context("stability of the Hessian")?;
     let mass = energy.lumped_mass();
@@ -427,6 +488,8 @@ pub fn analyse_from(
         max_u2,
         min_u1,
         regularised,
+        contact_force: report.contacts.iter().map(|c| c.force).sum(),
+        contacts: report.contacts.clone(),
         branch: 0,
         leg: 0,
         state: state.clone(),
@@ -441,6 +504,7 @@ pub fn starting_equilibrium(
 ) -> Result<(Newton, RodState, NewtonReport)> {
     let model = scene.rod_model(segments);
     let mut newton = Newton::new(RodEnergy::new(model.clone()));
+    newton.contact = scene.contact_model();
     if scene.initial.shape == InitialShape::DoubleRing {
         // unfold the double ring quasi-statically: straight from its own
         // clamps (0, 0, 2π) to the scene's

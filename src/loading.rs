@@ -46,6 +46,11 @@ pub fn settle(
     settings: &NewtonSettings,
 ) -> Result<crate::solve::newton::NewtonReport> {
     let mut report = newton.minimize(state, settings)?;
+    if !report.contacts.is_empty() {
+        // held by contacts: a minimum of the constrained problem (its
+        // stability is judged on the contacts' tangent space by `analyse`)
+        return Ok(report);
+    }
     for _ in 0..8 {
         let (neg, mode) = inertia(newton, state, true)?;
         if neg == 0 {
@@ -71,6 +76,9 @@ pub fn settle(
         let (_, s, r) = best.unwrap();
         *state = s;
         report = r;
+        if !report.contacts.is_empty() {
+            return Ok(report);
+        }
     }
     bail!("could not reach a stable equilibrium from a saddle")
 }
@@ -104,7 +112,9 @@ fn predict(newton: &mut Newton, state: &RodState, c: Clamps) -> Result<RodState>
     e.gradient_parameter_derivative(state, &velocity, &mut dq);
     let mut moved = state.clone();
     moved.set_clamps(c);
-    if newton.ldlt.factor(&v).is_ok() && newton.ldlt.negative_count() == 0 {
+    // with contact the free rod's tangent may run into an obstacle: only the
+    // clamp moves, the minimiser (with the contact rows) does the rest
+    if newton.contact.is_none() && newton.ldlt.factor(&v).is_ok() && newton.ldlt.negative_count() == 0 {
         newton.ldlt.solve_in_place(&mut dq);
         dq.iter_mut().for_each(|x| *x = -*x);
         let map = newton.energy.map;
@@ -254,6 +264,61 @@ pub fn run_loading(
                         Some(&landed_eq),
                     )?;
                 }
+            }
+            if eq.walled != next.walled && !step.jumped {
+                // entering or leaving the walls: locate it on the branch
+                let walled = |st: &RodState| {
+                    let (lo, hi) = st.z_range();
+                    lo > 0.0 && hi < st.clamps.z_star
+                };
+                let inside = eq.walled;
+                let (mut lo_state, mut hi) = (state.clone(), c);
+                while clamp_gap(&lo_state.clamps, &hi) > JUMP_LOCATION {
+                    let mid = midpoint(&lo_state.clamps, &hi);
+                    let trial = carry(newton, &lo_state, mid, settings).with_context(context)?;
+                    if walled(&trial.state) == inside {
+                        lo_state = trial.state;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                events.push(Event {
+                    kind: "wall".into(),
+                    label: String::new(),
+                    phi_over_2pi: hi.phi_over_2pi(),
+                    z_star: hi.z_star,
+                    delta: hi.delta,
+                    twist: eq.twist,
+                    branch: leg,
+                    detail: if inside { "leaves the walls" } else { "enters the walls" }.into(),
+                });
+            }
+            if !eq.contacts.is_empty() && next.contacts.is_empty() {
+                // the last contact opens: locate where its force reaches zero
+                let (mut lo_state, mut hi) = (state.clone(), c);
+                while clamp_gap(&lo_state.clamps, &hi) > JUMP_LOCATION {
+                    let mid = midpoint(&lo_state.clamps, &hi);
+                    let trial = carry(newton, &lo_state, mid, settings).with_context(context)?;
+                    if trial.report.contacts.is_empty() {
+                        hi = mid;
+                    } else {
+                        lo_state = trial.state;
+                    }
+                }
+                events.push(Event {
+                    kind: "contact_lost".into(),
+                    label: String::new(),
+                    phi_over_2pi: hi.phi_over_2pi(),
+                    z_star: hi.z_star,
+                    delta: hi.delta,
+                    twist: eq.twist,
+                    branch: leg,
+                    detail: format!(
+                        "contacts {} → none (total force {:.3} before)",
+                        eq.contacts.len(),
+                        eq.contact_force
+                    ),
+                });
             }
             observer(next.clone())?;
             state = step.state;

@@ -46,6 +46,9 @@ pub struct Scene {
     /// Knot diagnostics settings.
     #[serde(default)]
     pub diagnostics: DiagnosticsSpec,
+    /// `[contact]`: contact with the rays, obstacles and the rod itself.
+    #[serde(default)]
+    pub contact: Option<ContactSpec>,
     /// Published values to compare with (printed beside ours, never copied).
     #[serde(default)]
     pub reference: Option<ReferenceSpec>,
@@ -285,6 +288,33 @@ impl Default for DiagnosticsSpec {
         DiagnosticsSpec {
             self_distance_gap: 0.05,
             ray_length: 1e6,
+        }
+    }
+}
+
+/// `[contact]`: the rod as a tube of diameter `model.rod_diameter` that
+/// cannot pass through the clamps' rays, fixed obstacles or itself.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContactSpec {
+    /// Contact with the two rays continuing the clamps along e3.
+    pub rays: bool,
+    /// Self-contact (parts at least `diagnostics.self_distance_gap` apart).
+    pub self_contact: bool,
+    /// Fixed segment obstacles [x0, y0, z0, x1, y1, z1] (radius h/2).
+    pub obstacles: Vec<[f64; 6]>,
+    /// Pairs closer than h + margin become constraints; no node moves more
+    /// than margin/2 per step, so none can pass through another.
+    pub margin: f64,
+}
+
+impl Default for ContactSpec {
+    fn default() -> Self {
+        ContactSpec {
+            rays: true,
+            self_contact: true,
+            obstacles: Vec::new(),
+            margin: 0.02,
         }
     }
 }
@@ -613,6 +643,14 @@ impl Scene {
                 }
             }
         }
+        if let Some(c) = &self.contact {
+            positive("contact.margin", c.margin)?;
+            for o in &c.obstacles {
+                for v in o {
+                    finite("contact.obstacles", *v)?;
+                }
+            }
+        }
         let d = &self.diagnostics;
         positive("diagnostics.self_distance_gap", d.self_distance_gap)?;
         if d.self_distance_gap >= 0.5 {
@@ -649,6 +687,28 @@ impl Scene {
                 _ => Law::Kirchhoff,
             },
         }
+    }
+
+    /// The contact model, if the scene has a `[contact]` section.
+    pub fn contact_model(&self) -> Option<crate::geometry::contact::ContactModel> {
+        self.contact.as_ref().map(|c| crate::geometry::contact::ContactModel {
+            diameter: self.model.rod_diameter,
+            rays: c.rays,
+            self_contact: c.self_contact,
+            gap: self.diagnostics.self_distance_gap,
+            obstacles: c
+                .obstacles
+                .iter()
+                .map(|o| {
+                    [
+                        nalgebra::Vector3::new(o[0], o[1], o[2]),
+                        nalgebra::Vector3::new(o[3], o[4], o[5]),
+                    ]
+                })
+                .collect(),
+            margin: c.margin,
+            ray_length: 10.0,
+        })
     }
 
     /// The clamps.

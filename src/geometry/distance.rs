@@ -85,6 +85,61 @@ impl<'a> CurveTree<'a> {
     }
 }
 
+impl CurveTree<'_> {
+    /// Segment pairs (i < j), at least `gap` apart in arc length, closer than
+    /// `within`.
+    pub fn pairs_within(&self, arc: &[f64], gap: f64, within: f64) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        if self.nodes.is_empty() {
+            return out;
+        }
+        let points = self.points;
+        let mut stack = vec![(0usize, 0usize)];
+        while let Some((a, b)) = stack.pop() {
+            let (na, nb) = (&self.nodes[a], &self.nodes[b]);
+            if arc[nb.hi - 1] - arc[na.lo + 1] < gap || aabb_distance(&na.aabb, &nb.aabb) >= within {
+                continue;
+            }
+            match (na.children, nb.children) {
+                (None, None) => {
+                    for i in na.lo..na.hi {
+                        for j in nb.lo.max(i + 1)..nb.hi {
+                            if arc[j] - arc[i + 1] < gap {
+                                continue;
+                            }
+                            let (d, _, _) =
+                                segment_distance(&points[i], &points[i + 1], &points[j], &points[j + 1]);
+                            if d < within {
+                                out.push((i, j));
+                            }
+                        }
+                    }
+                }
+                _ => {
+                    let split_a = match (na.children, nb.children) {
+                        (Some(_), None) => true,
+                        (None, Some(_)) => false,
+                        _ => na.hi - na.lo >= nb.hi - nb.lo,
+                    };
+                    if a == b {
+                        let (l, r) = na.children.unwrap();
+                        stack.extend([(l, l), (l, r), (r, r)]);
+                    } else if split_a {
+                        let (l, r) = na.children.unwrap();
+                        stack.extend([(l, b), (r, b)]);
+                    } else {
+                        let (l, r) = nb.children.unwrap();
+                        stack.extend([(a, l), (a, r)]);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+}
+
 /// The closest approach of two parts of a curve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Approach {

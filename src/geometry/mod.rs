@@ -2,6 +2,7 @@
 //! self-distance and distance to the clamps' rays.
 
 pub mod closure;
+pub mod contact;
 pub mod distance;
 pub mod knot;
 pub mod polyline;

@@ -44,6 +44,9 @@ pub struct NewtonReport {
     pub energy: f64,
     /// Number of numerical factorisations.
     pub factorizations: usize,
+    /// Contact forces at the solution (with a contact model).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<crate::solve::sqp::ContactForce>,
 }
 
 impl NewtonReport {
@@ -55,6 +58,7 @@ impl NewtonReport {
             gradient_norm: f64::NAN,
             energy: f64::NAN,
             factorizations: 0,
+            contacts: Vec::new(),
         }
     }
 
@@ -117,6 +121,8 @@ pub struct Newton {
     pub energy: RodEnergy,
     /// Factorisation workspace.
     pub ldlt: Ldlt,
+    /// Contact with the rays, obstacles and itself (solved by SQP).
+    pub contact: Option<crate::geometry::contact::ContactModel>,
     grad: Vec<f64>,
     values: Vec<f64>,
     step: Vec<f64>,
@@ -132,6 +138,7 @@ impl Newton {
         Newton {
             energy,
             ldlt,
+            contact: None,
             grad: vec![0.0; n],
             values: vec![0.0; nnz],
             step: vec![0.0; n],
@@ -245,6 +252,34 @@ impl Newton {
             // constrained laws: SQP, each step a QP solved by clarabel
             return crate::solve::sqp::minimize(self, state, settings);
         }
+        if let Some(model) = self.contact.clone() {
+            // Newton while nothing is near contact (steps capped so that no
+            // pair can close the margin in one), SQP with contact rows once
+            // something is
+            let capped = NewtonSettings {
+                max_step: settings.max_step.min(0.5 * model.margin),
+                ..*settings
+            };
+            let near = |s: &RodState| !model.gaps(s).is_empty();
+            if !near(state) {
+                let report = self.minimize_until(state, &capped, Some(&near))?;
+                if report.converged {
+                    return Ok(report);
+                }
+            }
+            return crate::solve::sqp::minimize(self, state, settings);
+        }
+        self.minimize_until(state, settings, None)
+    }
+
+    /// Newton minimisation that stops early (not converged) at the first
+    /// accepted iterate where `stop` holds.
+    fn minimize_until(
+        &mut self,
+        state: &mut RodState,
+        settings: &NewtonSettings,
+        stop: Option<&dyn Fn(&RodState) -> bool>,
+    ) -> Result<NewtonReport, SolveError> {
         let mut report = NewtonReport::start();
         let mut shift = 0.0f64;
         let mut next_shift = 0.0f64;
@@ -350,6 +385,9 @@ impl Newton {
                 (10.0 * shift).max(1e-8 * diag_scale)
             };
             std::mem::swap(state, &mut trial);
+            if stop.is_some_and(|f| f(state)) {
+                return Ok(report);
+            }
         }
         Err(report.not_converged())
     }

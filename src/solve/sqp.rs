@@ -11,13 +11,18 @@
 //! Lagrangian with the new λ (no Maratos effect: full steps near the solution,
 //! quadratic convergence).
 
+use crate::geometry::contact::{Gap, Obstacle};
 use crate::model::rod::RodState;
 use crate::solve::kkt::Kkt;
 use crate::solve::newton::{Newton, NewtonReport, NewtonSettings, SolveError, residual};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
-    DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT::ZeroConeT,
+    DefaultSettings, DefaultSolver, IPSolver, SolverStatus,
+    SupportedConeT::{NonnegativeConeT, ZeroConeT},
 };
+
+/// Relative KKT residual accepted with active contacts.
+pub const CONTACT_TOL: f64 = 1e-7;
 
 /// The constraint holds when |u2| ≤ this at every vertex (u2 = κ2 / h).
 pub const CURVATURE_TOL: f64 = 1e-10;
@@ -114,8 +119,50 @@ fn qp_settings() -> DefaultSettings<f64> {
     }
 }
 
-/// Minimise the energy of a constrained rod from `state` (updated in place);
-/// its multipliers are updated with it.
+/// A contact force of an equilibrium.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ContactForce {
+    /// Arc length on the rod.
+    pub s: f64,
+    /// What it touches ("ray_bottom", "ray_top", "obstacle_k", "self").
+    pub obstacle: String,
+    /// Magnitude of the normal force (the multiplier of gap ≥ 0), in units
+    /// of B/L².
+    pub force: f64,
+    /// Gap (distance − h) there: 0 in contact, to solver tolerance.
+    pub gap: f64,
+}
+
+/// Contact rows of one iterate: candidate gaps and their gradients on the
+/// free dofs (row-major, sparse).
+fn contact_rows(newton: &Newton, state: &RodState) -> (Vec<Gap>, Vec<Vec<(usize, f64)>>) {
+    let Some(model) = &newton.contact else {
+        return (Vec::new(), Vec::new());
+    };
+    let map = newton.energy.map;
+    let gaps = model.gaps(state);
+    let rows = gaps
+        .iter()
+        .map(|g| {
+            let mut row = Vec::new();
+            for (k, grad) in &g.gradient {
+                // centreline point k is node k (points 0 and N+1 are the
+                // clamps' end points, fixed)
+                if let Some(d) = map.node(*k) {
+                    for c in 0..3 {
+                        row.push((d + c, grad[c]));
+                    }
+                }
+            }
+            row
+        })
+        .collect();
+    (gaps, rows)
+}
+
+/// Minimise the energy of a rod with constraints (u2 = 0 of a constrained
+/// law, contact inequalities) from `state` (updated in place, with its
+/// multipliers).
 pub fn minimize(
     newton: &mut Newton,
     state: &mut RodState,
@@ -124,36 +171,61 @@ pub fn minimize(
     let map = newton.energy.map;
     let n = map.len();
     let h = newton.energy.model.segment_length();
-    let penalty = newton.energy.penalty.expect("a constrained law");
+    let constrained = newton.energy.penalty.is_some();
+    let penalty = newton.energy.penalty.unwrap_or(0.0);
     let segments = newton.energy.model.segments;
-    state.multipliers.resize(segments + 1, 0.0);
+    if constrained {
+        state.multipliers.resize(segments + 1, 0.0);
+    }
+    let m_eq = if constrained { segments } else { 0 };
     let nnz = newton.energy.pattern.nnz();
     let mut grad = vec![0.0; n];
     let mut values = vec![0.0; nnz];
     let mut jtc = vec![0.0; n];
+    let mut jtl = vec![0.0; n];
     let mut jacobian = ConstraintMatrix::new(newton);
-    let mut kkt = Kkt::new(&newton.energy);
+    let mut kkt = constrained.then(|| Kkt::new(&newton.energy));
     let p_pattern = &newton.energy.pattern.matrix;
     let (p_colptr, p_rowval) = (
         p_pattern.col_offsets().to_vec(),
         p_pattern.row_indices().to_vec(),
     );
+    let step_cap = match &newton.contact {
+        Some(c) => settings.max_step.min(0.5 * c.margin),
+        None => settings.max_step,
+    };
     let mut solver: Option<DefaultSolver<f64>> = None;
     let mut report = NewtonReport::start();
     let mut trial = state.clone();
-    let mut shift = 0.0f64;
+    let mut shift;
+    // contact forces of the last QP, by (segments, obstacle kind)
+    let mut forces: Vec<(Gap, f64)> = Vec::new();
     for it in 0..=settings.max_iterations {
         let info = newton.energy.hessian(state, &mut grad, &mut values);
-        let rows = newton.energy.constraint_rows(state);
+        let rows = if constrained {
+            newton.energy.constraint_rows(state)
+        } else {
+            Vec::new()
+        };
         let c: Vec<f64> = rows.iter().map(|r| r.0).collect();
         jacobian.fill(&rows);
-        // Lagrangian gradient ∇E + Jᵀλ = ∇(augmented) − ρ Jᵀc
-        jacobian.transpose_mul(&c, &mut jtc);
-        let lagrangian: Vec<f64> = grad
-            .iter()
-            .zip(&jtc)
-            .map(|(g, j)| g - penalty * j)
-            .collect();
+        let (gaps, gap_rows) = contact_rows(newton, state);
+        // Lagrangian gradient ∇E + Jᵀλ − Σ z ∇g = ∇(augmented) − ρ Jᵀc − Σ z ∇g
+        let mut lagrangian = grad.clone();
+        if constrained {
+            jacobian.transpose_mul(&c, &mut jtc);
+            lagrangian
+                .iter_mut()
+                .zip(&jtc)
+                .for_each(|(l, j)| *l -= penalty * j);
+        }
+        for (g, z) in &forces {
+            if let Some(k) = gaps.iter().position(|x| same_pair(x, g)) {
+                for &(d, v) in &gap_rows[k] {
+                    lagrangian[d] -= z * v;
+                }
+            }
+        }
         let gnorm = lagrangian.iter().map(|x| x * x).sum::<f64>().sqrt();
         let max_diag = newton
             .energy
@@ -164,6 +236,7 @@ pub fn minimize(
             .fold(0.0, f64::max);
         let (rel, at_floor) = residual(&info, gnorm, max_diag, state, n);
         let infeasibility = c.iter().map(|x| (x / h).abs()).fold(0.0, f64::max);
+        let penetration = gaps.iter().map(|g| -g.gap).fold(0.0, f64::max);
         if !rel.is_finite() || !infeasibility.is_finite() {
             return Err(SolveError::NonFinite {
                 step: "constrained gradient",
@@ -171,15 +244,44 @@ pub fn minimize(
             });
         }
         report.record(it, rel.max(infeasibility), info.energy);
-        if (rel <= settings.gradient_tol || at_floor) && infeasibility <= CURVATURE_TOL {
+        let contact_ok = newton
+            .contact
+            .as_ref()
+            .is_none_or(|m| penetration <= 1e-6 * m.diameter);
+        // with contacts the KKT residual stalls near 1e-8: the closest points
+        // of a rod lying along an obstacle are not smooth functions of the
+        // nodes (and the interior-point duals carry that accuracy)
+        let tol = if forces.iter().any(|f| f.1 > 0.0) {
+            settings.gradient_tol.max(CONTACT_TOL)
+        } else {
+            settings.gradient_tol
+        };
+        if (rel <= tol || at_floor)
+            && infeasibility <= CURVATURE_TOL
+            && contact_ok
+        {
             report.converged = true;
+            let rows: Vec<ContactForce> = forces
+                .iter()
+                .filter(|(_, z)| *z > 0.0)
+                .filter_map(|(g, z)| {
+                    let now = gaps.iter().find(|x| same_pair(x, g))?;
+                    Some(ContactForce {
+                        s: now.s,
+                        obstacle: now.obstacle.name(),
+                        force: *z,
+                        gap: now.gap,
+                    })
+                })
+                .collect();
+            report.contacts = merge_contacts(rows, 1.5 * h);
             return Ok(report);
         }
         if it == settings.max_iterations {
             break;
         }
-        // convexify: the smallest diagonal shift making W positive definite
-        let previous = shift;
+        // convexify: W + shift I positive definite, the shift just beyond the
+        // lowest eigenvalue (a larger one would make a falling rod creep)
         shift = 0.0;
         loop {
             for &s in &newton.energy.pattern.diagonal {
@@ -193,9 +295,19 @@ pub fn minimize(
                 values[s] -= shift;
             }
             shift = if shift == 0.0 {
-                (0.1 * previous).max(1e-8 * max_diag)
+                let lowest = crate::stability::lowest_eigenvalues(
+                    &newton.energy.pattern,
+                    &values,
+                    None,
+                    1,
+                    &mut newton.ldlt,
+                )
+                .ok()
+                .and_then(|sp| sp.values.first().copied())
+                .unwrap_or(-1e-8 * max_diag);
+                1.5 * lowest.abs() + 1e-8 * max_diag
             } else {
-                10.0 * shift
+                2.0 * shift
             };
             if shift > 1e6 * max_diag {
                 return Err(SolveError::NonFinite {
@@ -205,58 +317,125 @@ pub fn minimize(
             }
         }
         // QP: linear term ∇E + ρ Jᵀc = ∇(augmented) − Jᵀλ
-        let mut jtl = vec![0.0; n];
-        jacobian.transpose_mul(&state.multipliers[1..], &mut jtl);
-        let q: Vec<f64> = grad.iter().zip(&jtl).map(|(g, j)| g - j).collect();
-        let b: Vec<f64> = c.iter().map(|x| -x).collect();
-        let (mut d, mut new_lambda) = solve_qp(
-            &mut solver,
-            (&p_colptr, &p_rowval, &values),
-            &q,
-            &jacobian.matrix,
-            &b,
-        )
-        .ok_or(SolveError::NonFinite {
-            step: "SQP subproblem (clarabel)",
-            iteration: it,
-        })?;
-        // polish: Newton on the QP's KKT conditions with the exact sparse
-        // KKT factorisation (the active set is all rows: equalities)
-        kkt.assemble(&values, &rows);
-        if kkt.ldlt.factor(&kkt.values).is_ok() {
-            report.factorizations += 1;
-            for _ in 0..2 {
-                let mut r = vec![0.0; n + segments];
-                newton.energy.pattern.mul_vec(&values, &d, &mut r[..n]);
-                jacobian.transpose_mul(&new_lambda, &mut jtl);
-                for k in 0..n {
-                    r[k] = -(r[k] + q[k] + jtl[k]);
+        let mut q = grad.clone();
+        if constrained {
+            jacobian.transpose_mul(&state.multipliers[1..], &mut jtl);
+            q.iter_mut().zip(&jtl).for_each(|(g, j)| *g -= j);
+        }
+        let (mut d, mut new_lambda, z) = if m_eq == 0 && gaps.is_empty() {
+            // nothing to constrain: the Newton step, or near a saddle (small
+            // gradient, indefinite H: a shifted step would creep) a step
+            // along the direction of negative curvature, downhill
+            let mut d: Vec<f64> = q.iter().map(|x| -x).collect();
+            newton.ldlt.solve_in_place(&mut d);
+            if shift > 0.0 && rel < 1e-6 {
+                let mut h = values.clone();
+                for &s in &newton.energy.pattern.diagonal {
+                    h[s] -= shift;
                 }
-                jacobian.mul(&d, &mut r[n..]);
-                for (rc, ck) in r[n..].iter_mut().zip(&c) {
-                    *rc = -(*rc + ck);
+                if let Ok(sp) = crate::stability::lowest_eigenvalues(
+                    &newton.energy.pattern,
+                    &h,
+                    None,
+                    1,
+                    &mut newton.ldlt,
+                ) && let (Some(&lambda), Some(v)) = (sp.values.first(), sp.vectors.first())
+                {
+                    let largest = (0..n)
+                        .filter(|&k| map.is_translation(k))
+                        .map(|k| v[k].abs())
+                        .fold(0.0, f64::max);
+                    if lambda < 0.0 && largest > 0.0 {
+                        let uphill: f64 = v.iter().zip(&q).map(|(a, b)| a * b).sum();
+                        let scale = if uphill > 0.0 { -1e-3 } else { 1e-3 } / largest;
+                        d = v.iter().map(|x| scale * x).collect();
+                    }
                 }
-                kkt.ldlt.solve_in_place(&mut r);
-                d.iter_mut().zip(&r[..n]).for_each(|(x, y)| *x += y);
-                new_lambda
-                    .iter_mut()
-                    .zip(&r[n..])
-                    .for_each(|(x, y)| *x += y);
+            }
+            (d, Vec::new(), Vec::new())
+        } else {
+            let (a, b) = stack_rows(&jacobian.matrix, &c, &gap_rows, &gaps, n);
+            if !gaps.is_empty() {
+                // the contact rows change from step to step
+                solver = None;
+            }
+            let (d, duals) = solve_qp(
+                &mut solver,
+                (&p_colptr, &p_rowval, &values),
+                &q,
+                &a,
+                &b,
+                m_eq,
+            )
+            .ok_or(SolveError::NonFinite {
+                step: "SQP subproblem (clarabel)",
+                iteration: it,
+            })?;
+            let (l, z) = duals.split_at(m_eq);
+            (d, l.to_vec(), z.to_vec())
+        };
+        // polish (equality rows only): Newton on the QP's KKT conditions with
+        // the exact sparse KKT factorisation
+        if let Some(kkt) = kkt.as_mut().filter(|_| gaps.is_empty()) {
+            kkt.assemble(&values, &rows);
+            if kkt.ldlt.factor(&kkt.values).is_ok() {
+                report.factorizations += 1;
+                for _ in 0..2 {
+                    let mut r = vec![0.0; n + segments];
+                    newton.energy.pattern.mul_vec(&values, &d, &mut r[..n]);
+                    jacobian.transpose_mul(&new_lambda, &mut jtl);
+                    for k in 0..n {
+                        r[k] = -(r[k] + q[k] + jtl[k]);
+                    }
+                    jacobian.mul(&d, &mut r[n..]);
+                    for (rc, ck) in r[n..].iter_mut().zip(&c) {
+                        *rc = -(*rc + ck);
+                    }
+                    kkt.ldlt.solve_in_place(&mut r);
+                    d.iter_mut().zip(&r[..n]).for_each(|(x, y)| *x += y);
+                    new_lambda
+                        .iter_mut()
+                        .zip(&r[n..])
+                        .for_each(|(x, y)| *x += y);
+                }
             }
         }
+        // polish (contacts, no equality rows): the active contacts as
+        // equalities, their forces from the small Schur complement G P⁻¹ Gᵀ
+        // (one sparse solve per active contact)
+        let mut z = z;
+        if m_eq == 0 && !gaps.is_empty() {
+            if let Some((dp, zp)) = polish_contacts(newton, &q, &gap_rows, &gaps, &z) {
+                d = dp;
+                z = zp;
+            }
+        }
+        forces = gaps.iter().cloned().zip(z.iter().map(|v| v.max(0.0))).collect();
         let mut step = d;
         let largest = (0..n)
             .filter(|&k| map.is_translation(k))
             .map(|k| step[k].abs())
             .fold(0.0, f64::max);
-        if largest > settings.max_step {
-            let f = settings.max_step / largest;
+        if largest > step_cap {
+            let f = step_cap / largest;
             step.iter_mut().for_each(|v| *v *= f);
         }
-        // merit: the augmented Lagrangian with the new multipliers
-        state.multipliers[1..].copy_from_slice(&new_lambda);
+        // merit: the augmented Lagrangian with the new multipliers, plus an
+        // exact penalty on the contact gaps
+        if constrained {
+            state.multipliers[1..].copy_from_slice(&new_lambda);
+        }
+        let mu = 2.0 * z.iter().fold(0.0f64, |a, b| a.max(*b)) + 1.0;
+        let contact_penalty = |s: &RodState| -> f64 {
+            match &newton.contact {
+                Some(m) => gaps.iter().map(|g| (-m.gap_at(s, g)).max(0.0)).sum::<f64>() * mu,
+                None => 0.0,
+            }
+        };
         let merit_info = newton.energy.gradient(state, &mut grad);
-        let slope: f64 = step.iter().zip(&grad).map(|(s, g)| s * g).sum();
+        let merit0 = merit_info.energy + contact_penalty(state);
+        let slope: f64 = step.iter().zip(&grad).map(|(s, g)| s * g).sum::<f64>()
+            - mu * gaps.iter().map(|g| (-g.gap).max(0.0)).sum::<f64>();
         let mut alpha = 1.0;
         let mut accepted = false;
         let mut trial_step = vec![0.0; n];
@@ -265,9 +444,33 @@ pub fn minimize(
                 *t = alpha * v;
             }
             state.displace_into(&map, &trial_step, &mut trial);
-            let e = newton.energy.energy(&trial);
-            let tol = 1e-14 * merit_info.energy.abs().max(1.0);
-            if e.is_finite() && e <= merit_info.energy + 1e-4 * alpha * slope.min(0.0) + tol {
+            // continuous collision check: no candidate pair may pass through
+            // contact along the step (sub-steps finer than half a diameter;
+            // pairs beyond the margin cannot close it in one step)
+            if let Some(m) = &newton.contact
+                && !gaps.is_empty()
+            {
+                let largest_move = alpha * largest.min(step_cap);
+                let pieces = ((4.0 * largest_move / m.diameter).ceil() as usize).clamp(1, 64);
+                let mut sub = state.clone();
+                let mut through = false;
+                for k in 1..=pieces {
+                    let f = k as f64 / pieces as f64;
+                    let part: Vec<f64> = trial_step.iter().map(|x| f * x).collect();
+                    state.displace_into(&map, &part, &mut sub);
+                    if gaps.iter().any(|g| m.gap_at(&sub, g) < -0.5 * m.diameter) {
+                        through = true;
+                        break;
+                    }
+                }
+                if through {
+                    alpha *= 0.5;
+                    continue;
+                }
+            }
+            let e = newton.energy.energy(&trial) + contact_penalty(&trial);
+            let tol = 1e-14 * merit0.abs().max(1.0);
+            if e.is_finite() && e <= merit0 + 1e-4 * alpha * slope.min(0.0) + tol {
                 accepted = true;
                 break;
             }
@@ -279,9 +482,163 @@ pub fn minimize(
                 residual: rel,
             });
         }
+        if std::env::var("KNOTROD_DEBUG_SQP").is_ok() && it % 50 == 0 {
+            eprintln!(
+                "it {it} rel {rel:.3e} pen {penetration:.2e} alpha {alpha} |d| {largest:.2e} gaps {} active {} z {:?}",
+                gaps.len(),
+                forces.iter().filter(|f| f.1 > 0.0).count(),
+                forces.iter().map(|f| f.1).filter(|z| *z > 0.0).collect::<Vec<_>>()
+            );
+        }
         std::mem::swap(state, &mut trial);
     }
     Err(report.not_converged())
+}
+
+/// Newton on the QP's KKT conditions with the active contacts as equalities
+/// (P factored in `newton.ldlt`): returns the step and the contact forces, or
+/// None if the active set is empty or a force comes out negative twice.
+fn polish_contacts(
+    newton: &mut Newton,
+    q: &[f64],
+    gap_rows: &[Vec<(usize, f64)>],
+    gaps: &[Gap],
+    z: &[f64],
+) -> Option<(Vec<f64>, Vec<f64>)> {
+    let n = q.len();
+    let zmax = z.iter().fold(0.0f64, |a, b| a.max(*b));
+    let mut active: Vec<usize> = (0..gaps.len()).filter(|&k| z[k] > 1e-6 * zmax && zmax > 0.0).collect();
+    for _ in 0..3 {
+        if active.is_empty() {
+            return None;
+        }
+        let dense = |row: &[(usize, f64)]| {
+            let mut v = vec![0.0; n];
+            for &(d, x) in row {
+                v[d] += x;
+            }
+            v
+        };
+        // P⁻¹ q and P⁻¹ Gᵀ (columns)
+        let mut pq = q.to_vec();
+        newton.ldlt.solve_in_place(&mut pq);
+        let pg: Vec<Vec<f64>> = active
+            .iter()
+            .map(|&k| {
+                let mut v = dense(&gap_rows[k]);
+                newton.ldlt.solve_in_place(&mut v);
+                v
+            })
+            .collect();
+        let m = active.len();
+        let dot = |row: &[(usize, f64)], v: &[f64]| row.iter().map(|&(d, x)| x * v[d]).sum::<f64>();
+        let s = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&gap_rows[active[i]], &pg[j]));
+        let rhs = nalgebra::DVector::from_fn(m, |i, _| dot(&gap_rows[active[i]], &pq) - gaps[active[i]].gap);
+        let zs = s.lu().solve(&rhs)?;
+        if let Some(i) = (0..m).find(|&i| zs[i] < 0.0) {
+            active.remove(i);
+            continue;
+        }
+        let mut d: Vec<f64> = pq.iter().map(|x| -x).collect();
+        for (i, v) in pg.iter().enumerate() {
+            d.iter_mut().zip(v).for_each(|(x, y)| *x += zs[i] * y);
+        }
+        let mut full = vec![0.0; gaps.len()];
+        for (i, &k) in active.iter().enumerate() {
+            full[k] = zs[i];
+        }
+        // the polished step must keep the other contacts open (linearised)
+        let ok = (0..gaps.len())
+            .filter(|k| !active.contains(k))
+            .all(|k| gaps[k].gap + dot(&gap_rows[k], &d) >= -1e-12);
+        return ok.then_some((d, full));
+    }
+    None
+}
+
+/// One contact per touching region: rows of neighbouring segments (within
+/// `reach` in arc length) pressing on the same obstacle are one contact, at
+/// their force-weighted arc length, with their total force; negligible rows
+/// (below 1e-6 of the largest force: interior-point residue) are dropped.
+fn merge_contacts(mut rows: Vec<ContactForce>, reach: f64) -> Vec<ContactForce> {
+    let largest = rows.iter().map(|c| c.force).fold(0.0, f64::max);
+    rows.retain(|c| c.force > 1e-6 * largest);
+    rows.sort_by(|a, b| a.obstacle.cmp(&b.obstacle).then(a.s.total_cmp(&b.s)));
+    let mut out: Vec<(ContactForce, f64)> = Vec::new(); // contact, last s
+    for c in rows {
+        if let Some((m, last)) = out.last_mut()
+            && m.obstacle == c.obstacle
+            && c.s - *last <= reach
+        {
+            let f = m.force + c.force;
+            m.s = (m.s * m.force + c.s * c.force) / f;
+            m.force = f;
+            m.gap = m.gap.min(c.gap);
+            *last = c.s;
+            continue;
+        }
+        let s = c.s;
+        out.push((c, s));
+    }
+    let mut merged: Vec<ContactForce> = out.into_iter().map(|(c, _)| c).collect();
+    merged.sort_by(|a, b| a.s.total_cmp(&b.s));
+    merged
+}
+
+/// The same contact pair (segments and kind of obstacle).
+fn same_pair(a: &Gap, b: &Gap) -> bool {
+    a.segments == b.segments
+        && std::mem::discriminant(&a.obstacle) == std::mem::discriminant(&b.obstacle)
+        && match (a.obstacle, b.obstacle) {
+            (Obstacle::Fixed(x), Obstacle::Fixed(y)) => x == y,
+            _ => true,
+        }
+}
+
+/// The QP's constraint matrix and right-hand side: equality rows J d = −c,
+/// then contact rows −∇g d + s = g, s ≥ 0.
+fn stack_rows(
+    jacobian: &CscMatrix<f64>,
+    c: &[f64],
+    gap_rows: &[Vec<(usize, f64)>],
+    gaps: &[Gap],
+    n: usize,
+) -> (CscMatrix<f64>, Vec<f64>) {
+    let m_eq = c.len();
+    let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+    if m_eq > 0 {
+        for (col, entries) in cols.iter_mut().enumerate() {
+            for k in jacobian.colptr[col]..jacobian.colptr[col + 1] {
+                entries.push((jacobian.rowval[k], jacobian.nzval[k]));
+            }
+        }
+    }
+    for (r, row) in gap_rows.iter().enumerate() {
+        for &(d, v) in row {
+            cols[d].push((m_eq + r, -v));
+        }
+    }
+    let mut colptr = vec![0usize];
+    let (mut rowval, mut nzval) = (Vec::new(), Vec::new());
+    for mut entries in cols {
+        entries.sort_by_key(|e| e.0);
+        // merge duplicates (a self pair's two segments can share a dof)
+        let mut last: Option<usize> = None;
+        for (r, v) in entries {
+            if last == Some(r) {
+                *nzval.last_mut().unwrap() += v;
+            } else {
+                rowval.push(r);
+                nzval.push(v);
+                last = Some(r);
+            }
+        }
+        colptr.push(rowval.len());
+    }
+    let rows = m_eq + gaps.len();
+    let mut b: Vec<f64> = c.iter().map(|x| -x).collect();
+    b.extend(gaps.iter().map(|g| g.gap));
+    (CscMatrix::new(rows, n, colptr, rowval, nzval), b)
 }
 
 /// Solve the QP with clarabel (set up once, then only its data updated);
@@ -292,6 +649,7 @@ fn solve_qp(
     q: &[f64],
     a: &CscMatrix<f64>,
     b: &[f64],
+    m_eq: usize,
 ) -> Option<(Vec<f64>, Vec<f64>)> {
     let (colptr, rowval, values) = p;
     let n = q.len();
@@ -304,7 +662,13 @@ fn solve_qp(
         }
         None => {
             let pm = CscMatrix::new(n, n, colptr.to_vec(), rowval.to_vec(), values.to_vec());
-            let cones = [ZeroConeT(b.len())];
+            let mut cones = Vec::new();
+            if m_eq > 0 {
+                cones.push(ZeroConeT(m_eq));
+            }
+            if b.len() > m_eq {
+                cones.push(NonnegativeConeT(b.len() - m_eq));
+            }
             *solver = Some(DefaultSolver::new(&pm, q, a, b, &cones, qp_settings()).ok()?);
         }
     }
@@ -315,7 +679,9 @@ fn solve_qp(
         // an interior-point solve stalls short of full accuracy on these
         // stiff QPs (ρ JᵀJ against bending): keep its iterate, the polish
         // below makes it exact
-        _ => {}
+        SolverStatus::MaxIterations | SolverStatus::InsufficientProgress => {}
+        // infeasible linearised contacts (or worse): no step to take
+        _ => return None,
     }
     let x = s.solution.x.clone();
     let z = s.solution.z.clone();
