@@ -27,15 +27,16 @@ fn bench(c: &mut Criterion) {
         .iter()
         .map(|&n| (n, solve_scene(&d, Some(n)).unwrap()))
         .collect();
-    let mut group = |name: &str, f: &dyn Fn(usize, &knotrod::equilibrium::Equilibrium) -> Box<dyn FnMut()>| {
-        let mut g = c.benchmark_group(name);
-        g.sample_size(10);
-        for (n, eq) in &solved {
-            let mut run = f(*n, eq);
-            g.bench_with_input(BenchmarkId::from_parameter(n), n, |b, _| b.iter(&mut run));
-        }
-        g.finish();
-    };
+    let mut group =
+        |name: &str, f: &dyn Fn(usize, &knotrod::equilibrium::Equilibrium) -> Box<dyn FnMut()>| {
+            let mut g = c.benchmark_group(name);
+            g.sample_size(10);
+            for (n, eq) in &solved {
+                let mut run = f(*n, eq);
+                g.bench_with_input(BenchmarkId::from_parameter(n), n, |b, _| b.iter(&mut run));
+            }
+            g.finish();
+        };
     group("energy", &|n, eq| {
         let energy = RodEnergy::new(d.rod_model(Some(n)));
         let state = eq.state.clone();
@@ -96,7 +97,8 @@ fn bench(c: &mut Criterion) {
         let state = eq.state.clone();
         let previous = eq.clone();
         Box::new(move || {
-            let mut tracer = Tracer::new(&mut newton, Parameter::Phi, ContinuationSettings::default());
+            let mut tracer =
+                Tracer::new(&mut newton, Parameter::Phi, ContinuationSettings::default());
             let a = tracer.start(state.clone(), 1.0).unwrap();
             let b = tracer.correct(&a, 0.005, None).unwrap();
             let report = knotrod::solve::newton::NewtonReport {
@@ -109,8 +111,14 @@ fn bench(c: &mut Criterion) {
                 contacts: Vec::new(),
             };
             drop(tracer);
-            knotrod::equilibrium::analyse_from(&mut newton, &b.state, &report, &measure, Some(&previous))
-                .unwrap();
+            knotrod::equilibrium::analyse_from(
+                &mut newton,
+                &b.state,
+                &report,
+                &measure,
+                Some(&previous),
+            )
+            .unwrap();
         })
     });
     let _ = analyse;

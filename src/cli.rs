@@ -574,7 +574,13 @@ fn map_command(
             "slice {k}: {} = {v}",
             slices.parameter.name()
         )?;
-        if let Some(m) = map_plane(&slice, &format!("{name} ({} = {v})", slices.parameter.name()), &file, shard, segments)? {
+        if let Some(m) = map_plane(
+            &slice,
+            &format!("{name} ({} = {v})", slices.parameter.name()),
+            &file,
+            shard,
+            segments,
+        )? {
             maps.push(m);
         }
     }
@@ -608,7 +614,10 @@ fn map_plane(
     shard: Option<(usize, usize)>,
     segments: Option<usize>,
 ) -> Result<Option<crate::map::Map>> {
-    let spec = scene.map.clone().context("the scene has no [map] section")?;
+    let spec = scene
+        .map
+        .clone()
+        .context("the scene has no [map] section")?;
     let cont = scene
         .continuation
         .as_ref()

@@ -114,7 +114,10 @@ fn predict(newton: &mut Newton, state: &RodState, c: Clamps) -> Result<RodState>
     moved.set_clamps(c);
     // with contact the free rod's tangent may run into an obstacle: only the
     // clamp moves, the minimiser (with the contact rows) does the rest
-    if newton.contact.is_none() && newton.ldlt.factor(&v).is_ok() && newton.ldlt.negative_count() == 0 {
+    if newton.contact.is_none()
+        && newton.ldlt.factor(&v).is_ok()
+        && newton.ldlt.negative_count() == 0
+    {
         newton.ldlt.solve_in_place(&mut dq);
         dq.iter_mut().for_each(|x| *x = -*x);
         let map = newton.energy.map;
@@ -256,13 +259,8 @@ pub fn run_loading(
                         ),
                     });
                     step = carry(newton, &landed.state, c, settings).with_context(context)?;
-                    next = analyse_from(
-                        newton,
-                        &step.state,
-                        &step.report,
-                        measure,
-                        Some(&landed_eq),
-                    )?;
+                    next =
+                        analyse_from(newton, &step.state, &step.report, measure, Some(&landed_eq))?;
                 }
             }
             if eq.walled != next.walled && !step.jumped {
@@ -290,7 +288,12 @@ pub fn run_loading(
                     delta: hi.delta,
                     twist: eq.twist,
                     branch: leg,
-                    detail: if inside { "leaves the walls" } else { "enters the walls" }.into(),
+                    detail: if inside {
+                        "leaves the walls"
+                    } else {
+                        "enters the walls"
+                    }
+                    .into(),
                 });
             }
             if !eq.contacts.is_empty() && next.contacts.is_empty() {

@@ -218,7 +218,10 @@ pub fn assemble_3d(scene: &str, spec: &SliceSpec, slices: Vec<Map>) -> Map3 {
     Map3 {
         scene: scene.into(),
         slice_parameter: spec.parameter.name().into(),
-        parameter: slices.first().map(|m| m.parameter.clone()).unwrap_or_default(),
+        parameter: slices
+            .first()
+            .map(|m| m.parameter.clone())
+            .unwrap_or_default(),
         slice_values: spec.values.clone(),
         slice_areas: areas,
         good_volume: volume,

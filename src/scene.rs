@@ -627,7 +627,9 @@ impl Scene {
                 if sl.values.windows(2).any(|w| w[1] <= w[0]) {
                     return Err(invalid("map.slices.values", "must be increasing"));
                 }
-                if sl.parameter == m.parameter || Some(sl.parameter) == self.continuation.as_ref().map(|c| c.parameter) {
+                if sl.parameter == m.parameter
+                    || Some(sl.parameter) == self.continuation.as_ref().map(|c| c.parameter)
+                {
                     return Err(invalid(
                         "map.slices.parameter",
                         "must differ from map.parameter and continuation.parameter",
@@ -691,24 +693,26 @@ impl Scene {
 
     /// The contact model, if the scene has a `[contact]` section.
     pub fn contact_model(&self) -> Option<crate::geometry::contact::ContactModel> {
-        self.contact.as_ref().map(|c| crate::geometry::contact::ContactModel {
-            diameter: self.model.rod_diameter,
-            rays: c.rays,
-            self_contact: c.self_contact,
-            gap: self.diagnostics.self_distance_gap,
-            obstacles: c
-                .obstacles
-                .iter()
-                .map(|o| {
-                    [
-                        nalgebra::Vector3::new(o[0], o[1], o[2]),
-                        nalgebra::Vector3::new(o[3], o[4], o[5]),
-                    ]
-                })
-                .collect(),
-            margin: c.margin,
-            ray_length: 10.0,
-        })
+        self.contact
+            .as_ref()
+            .map(|c| crate::geometry::contact::ContactModel {
+                diameter: self.model.rod_diameter,
+                rays: c.rays,
+                self_contact: c.self_contact,
+                gap: self.diagnostics.self_distance_gap,
+                obstacles: c
+                    .obstacles
+                    .iter()
+                    .map(|o| {
+                        [
+                            nalgebra::Vector3::new(o[0], o[1], o[2]),
+                            nalgebra::Vector3::new(o[3], o[4], o[5]),
+                        ]
+                    })
+                    .collect(),
+                margin: c.margin,
+                ray_length: 10.0,
+            })
     }
 
     /// The clamps.

@@ -105,7 +105,11 @@ fn writhe_carried_along_a_branch_equals_the_full_writhe() {
     for e in &eqs {
         let full = Shape::of(&e.state, &measure);
         largest = largest.max((full.writhe - e.writhe).abs());
-        assert_eq!(full.knot.determinant, e.knot_determinant, "at φ/2π = {}", e.phi_over_2pi);
+        assert_eq!(
+            full.knot.determinant, e.knot_determinant,
+            "at φ/2π = {}",
+            e.phi_over_2pi
+        );
     }
     // the full writhe closes the rays at length 1e6: it differs by O(1e-6)
     assert!(largest < 1e-5, "largest writhe difference {largest:e}");

@@ -75,10 +75,7 @@ pub struct Gap {
 
 /// Closest points of segment a (points a0, a1) to segment b: the gap and the
 /// gradients on the four end points.
-fn pair_gap(
-    p: &[Vector3<f64>; 4],
-    diameter: f64,
-) -> (f64, f64, f64, [Vector3<f64>; 4]) {
+fn pair_gap(p: &[Vector3<f64>; 4], diameter: f64) -> (f64, f64, f64, [Vector3<f64>; 4]) {
     let (d, ta, tb) = segment_distance(&p[0], &p[1], &p[2], &p[3]);
     let pa = p[0] + ta * (p[1] - p[0]);
     let pb = p[2] + tb * (p[3] - p[2]);
@@ -87,7 +84,11 @@ fn pair_gap(
     } else {
         // coincident: any direction perpendicular to the first segment
         let t = (p[1] - p[0]).normalize();
-        let a = if t.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+        let a = if t.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        };
         (a - a.dot(&t) * t).normalize()
     };
     (
@@ -151,7 +152,12 @@ impl ContactModel {
                         gap: g,
                         s: arc[i] + ta * (arc[i + 1] - arc[i]),
                         obstacle: Obstacle::SelfAt(arc[j] + tb * (arc[j + 1] - arc[j])),
-                        gradient: vec![(i, grad[0]), (i + 1, grad[1]), (j, grad[2]), (j + 1, grad[3])],
+                        gradient: vec![
+                            (i, grad[0]),
+                            (i + 1, grad[1]),
+                            (j, grad[2]),
+                            (j + 1, grad[3]),
+                        ],
                         segments: [i, j],
                     });
                 }

@@ -97,7 +97,8 @@ impl CurveTree<'_> {
         let mut stack = vec![(0usize, 0usize)];
         while let Some((a, b)) = stack.pop() {
             let (na, nb) = (&self.nodes[a], &self.nodes[b]);
-            if arc[nb.hi - 1] - arc[na.lo + 1] < gap || aabb_distance(&na.aabb, &nb.aabb) >= within {
+            if arc[nb.hi - 1] - arc[na.lo + 1] < gap || aabb_distance(&na.aabb, &nb.aabb) >= within
+            {
                 continue;
             }
             match (na.children, nb.children) {
@@ -107,8 +108,12 @@ impl CurveTree<'_> {
                             if arc[j] - arc[i + 1] < gap {
                                 continue;
                             }
-                            let (d, _, _) =
-                                segment_distance(&points[i], &points[i + 1], &points[j], &points[j + 1]);
+                            let (d, _, _) = segment_distance(
+                                &points[i],
+                                &points[i + 1],
+                                &points[j],
+                                &points[j + 1],
+                            );
                             if d < within {
                                 out.push((i, j));
                             }

@@ -256,10 +256,7 @@ pub fn minimize(
         } else {
             settings.gradient_tol
         };
-        if (rel <= tol || at_floor)
-            && infeasibility <= CURVATURE_TOL
-            && contact_ok
-        {
+        if (rel <= tol || at_floor) && infeasibility <= CURVATURE_TOL && contact_ok {
             report.converged = true;
             let rows: Vec<ContactForce> = forces
                 .iter()
@@ -410,7 +407,11 @@ pub fn minimize(
                 z = zp;
             }
         }
-        forces = gaps.iter().cloned().zip(z.iter().map(|v| v.max(0.0))).collect();
+        forces = gaps
+            .iter()
+            .cloned()
+            .zip(z.iter().map(|v| v.max(0.0)))
+            .collect();
         let mut step = d;
         let largest = (0..n)
             .filter(|&k| map.is_translation(k))
@@ -487,7 +488,11 @@ pub fn minimize(
                 "it {it} rel {rel:.3e} pen {penetration:.2e} alpha {alpha} |d| {largest:.2e} gaps {} active {} z {:?}",
                 gaps.len(),
                 forces.iter().filter(|f| f.1 > 0.0).count(),
-                forces.iter().map(|f| f.1).filter(|z| *z > 0.0).collect::<Vec<_>>()
+                forces
+                    .iter()
+                    .map(|f| f.1)
+                    .filter(|z| *z > 0.0)
+                    .collect::<Vec<_>>()
             );
         }
         std::mem::swap(state, &mut trial);
@@ -507,7 +512,9 @@ fn polish_contacts(
 ) -> Option<(Vec<f64>, Vec<f64>)> {
     let n = q.len();
     let zmax = z.iter().fold(0.0f64, |a, b| a.max(*b));
-    let mut active: Vec<usize> = (0..gaps.len()).filter(|&k| z[k] > 1e-6 * zmax && zmax > 0.0).collect();
+    let mut active: Vec<usize> = (0..gaps.len())
+        .filter(|&k| z[k] > 1e-6 * zmax && zmax > 0.0)
+        .collect();
     for _ in 0..3 {
         if active.is_empty() {
             return None;
@@ -533,7 +540,9 @@ fn polish_contacts(
         let m = active.len();
         let dot = |row: &[(usize, f64)], v: &[f64]| row.iter().map(|&(d, x)| x * v[d]).sum::<f64>();
         let s = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&gap_rows[active[i]], &pg[j]));
-        let rhs = nalgebra::DVector::from_fn(m, |i, _| dot(&gap_rows[active[i]], &pq) - gaps[active[i]].gap);
+        let rhs = nalgebra::DVector::from_fn(m, |i, _| {
+            dot(&gap_rows[active[i]], &pq) - gaps[active[i]].gap
+        });
         let zs = s.lu().solve(&rhs)?;
         if let Some(i) = (0..m).find(|&i| zs[i] < 0.0) {
             active.remove(i);

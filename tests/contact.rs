@@ -1,0 +1,132 @@
+//! Contact: a clamped beam pushed onto a point obstacle (beam theory), and
+//! the trefoil tied around the rays (configurations A → B → C, Figures 3-5).
+
+use knotrod::branch::Event;
+use knotrod::equilibrium::{Equilibrium, solve_scene};
+use knotrod::run::run_scene;
+use knotrod::scene::Scene;
+
+/// A straight clamped-clamped rod (z* = 1) whose midpoint is pushed sideways
+/// by `deflection` by a segment obstacle across it.
+fn beam(deflection: f64, segments: usize) -> Equilibrium {
+    let h = 0.005;
+    let x = h - deflection;
+    let scene = Scene::parse(&format!(
+        "[model]\nK2 = 3.0\nK3 = 3.0\nsegments = {segments}\nrod_diameter = {h}\n\
+         [clamps]\nz_star = 1.0\ndelta = 0.0\nphi_over_2pi = 0.0\n\
+         [contact]\nrays = false\nself_contact = false\n\
+         obstacles = [[{x}, -0.1, 0.5, {x}, 0.1, 0.5]]\n\
+         [stability]\neigenvalues = 1\n"
+    ))
+    .unwrap();
+    solve_scene(&scene, None).unwrap()
+}
+
+#[test]
+fn clamped_beam_on_a_point_obstacle_has_the_beam_theory_force() {
+    // midpoint deflection w under a central point load P of a clamped-clamped
+    // beam: w = P L³ / (192 B); the push is along d1 = e1, i.e. bending about
+    // d2, stiffness B22 = K2 B11 = 3
+    for (w, n) in [(1e-4, 100), (2e-4, 100), (1e-4, 200)] {
+        let e = beam(w, n);
+        assert!(e.converged);
+        assert_eq!(e.contacts.len(), 1, "{:?}", e.contacts);
+        let c = &e.contacts[0];
+        assert_eq!(c.obstacle, "obstacle_0");
+        assert!((c.s - 0.5).abs() < 1e-9, "contact at s = {}", c.s);
+        assert!(c.gap.abs() < 1e-9, "gap {}", c.gap);
+        let expected = 192.0 * 3.0 * w;
+        assert!(
+            (c.force - expected).abs() < 2e-3 * expected,
+            "w = {w}, N = {n}: force {} vs {expected}",
+            c.force
+        );
+        // the rod stops at distance h from the obstacle's axis
+        let mid = e.state.nodes[n / 2].x;
+        assert!((mid + w).abs() < 1e-8, "midpoint at x = {mid}");
+    }
+}
+
+#[test]
+fn trefoil_on_the_rays_a_to_b_to_c() {
+    let scene = Scene::load(std::path::Path::new("scenes/trefoil_contact_start.toml")).unwrap();
+    let mut eqs: Vec<Equilibrium> = Vec::new();
+    let events: Vec<Event> = run_scene(&scene, None, &mut |e| {
+        eqs.push(e);
+        Ok(())
+    })
+    .unwrap();
+    let h = scene.model.rod_diameter;
+    // nothing ever passes through anything: knot and link's integer part kept
+    for e in &eqs {
+        assert!(e.converged);
+        assert_eq!(e.knot_determinant, 3, "at φ/2π = {}", e.phi_over_2pi);
+        assert!(
+            e.min_self_distance > h * (1.0 - 1e-6),
+            "self-distance {} at φ/2π = {}",
+            e.min_self_distance,
+            e.phi_over_2pi
+        );
+        assert!(
+            e.contacts
+                .iter()
+                .all(|c| c.force > 0.0 && c.gap > -1e-6 * h)
+        );
+    }
+    // A: two contacts, one with each ray, at s ≈ 0.17 and 0.83
+    let a = &eqs[80];
+    assert!(a.phi_over_2pi.abs() < 1e-12);
+    assert_eq!(a.contacts.len(), 2, "{:?}", a.contacts);
+    let (lo, hi) = (&a.contacts[0], &a.contacts[1]);
+    assert!(
+        (lo.s - 0.17).abs() < 0.02 && (hi.s - 0.83).abs() < 0.02,
+        "{:?}",
+        a.contacts
+    );
+    assert!(lo.obstacle.starts_with("ray") && hi.obstacle.starts_with("ray"));
+    assert_ne!(lo.obstacle, hi.obstacle);
+    assert!((a.twist + 0.07).abs() < 0.02, "Tw = {}", a.twist);
+    assert!((a.link - 3.0).abs() < 0.05, "link = {}", a.link);
+    // B: the contact force reaches zero at φ/2π ≈ 0.768 and the rod jumps
+    let lost = events
+        .iter()
+        .find(|e| e.kind == "contact_lost" && e.branch == 1)
+        .expect("contact lost on the way up");
+    assert!(
+        (lost.phi_over_2pi - 0.768).abs() < 0.01,
+        "B at {}",
+        lost.phi_over_2pi
+    );
+    let jump = events
+        .iter()
+        .find(|e| {
+            e.kind == "jump" && e.branch == 1 && (e.phi_over_2pi - lost.phi_over_2pi).abs() < 1e-3
+        })
+        .expect("a jump at B");
+    let _ = jump;
+    // C: contact-free, stable, and through the walls at Figure 3's W1, W2
+    // (N = 100 continuation: 0.7740, 0.8186)
+    let walls: Vec<f64> = events
+        .iter()
+        .filter(|e| e.kind == "wall" && e.branch == 1)
+        .map(|e| e.phi_over_2pi)
+        .collect();
+    assert_eq!(walls.len(), 2, "{events:?}");
+    assert!(
+        (walls[0] - 0.7740).abs() < 0.005 && (walls[1] - 0.8186).abs() < 0.005,
+        "{walls:?}"
+    );
+    let c = eqs
+        .iter()
+        .skip(81)
+        .find(|e| e.phi_over_2pi > walls[0] + 0.005)
+        .unwrap();
+    assert!(c.contacts.is_empty() && c.stable && c.good_knot);
+    // back down: no jump back to B, but at S (≈ 0.751)
+    let down: Vec<&Event> = events
+        .iter()
+        .filter(|e| e.kind == "jump" && e.branch == 2)
+        .collect();
+    assert_eq!(down.len(), 1, "{events:?}");
+    assert!((down[0].phi_over_2pi - 0.751).abs() < 0.005);
+}
