@@ -17,6 +17,9 @@ use std::path::Path;
 
 const SIZES: [usize; 6] = [100, 200, 400, 800, 1600, 3200];
 
+/// Builds the measured closure for one N from its equilibrium.
+type Setup<'a> = &'a dyn Fn(usize, &knotrod::equilibrium::Equilibrium) -> Box<dyn FnMut()>;
+
 fn bench(c: &mut Criterion) {
     let d = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
     let measure = Measure {
@@ -27,16 +30,15 @@ fn bench(c: &mut Criterion) {
         .iter()
         .map(|&n| (n, solve_scene(&d, Some(n)).unwrap()))
         .collect();
-    let mut group =
-        |name: &str, f: &dyn Fn(usize, &knotrod::equilibrium::Equilibrium) -> Box<dyn FnMut()>| {
-            let mut g = c.benchmark_group(name);
-            g.sample_size(10);
-            for (n, eq) in &solved {
-                let mut run = f(*n, eq);
-                g.bench_with_input(BenchmarkId::from_parameter(n), n, |b, _| b.iter(&mut run));
-            }
-            g.finish();
-        };
+    let mut group = |name: &str, f: Setup| {
+        let mut g = c.benchmark_group(name);
+        g.sample_size(10);
+        for (n, eq) in &solved {
+            let mut run = f(*n, eq);
+            g.bench_with_input(BenchmarkId::from_parameter(n), n, |b, _| b.iter(&mut run));
+        }
+        g.finish();
+    };
     group("energy", &|n, eq| {
         let energy = RodEnergy::new(d.rod_model(Some(n)));
         let state = eq.state.clone();

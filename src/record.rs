@@ -62,12 +62,16 @@ pub struct Scalars {
     /// Highest interior z.
     pub max_z: f64,
     /// Wall clearance.
+    #[serde(deserialize_with = "null_as_nan")]
     pub wall_distance: f64,
     /// Minimum self-distance.
+    #[serde(deserialize_with = "null_as_nan")]
     pub min_self_distance: f64,
     /// Lowest Hessian eigenvalue.
+    #[serde(deserialize_with = "null_as_nan")]
     pub lowest_eigenvalue: f64,
     /// Lowest ω².
+    #[serde(deserialize_with = "null_as_nan")]
     pub lowest_omega_squared: f64,
     /// Negative eigenvalues.
     pub negative_eigenvalues: usize,
@@ -77,8 +81,15 @@ pub struct Scalars {
     pub good_knot: bool,
     /// Newton/corrector iterations.
     pub iterations: usize,
-    /// Total contact force (no contact model yet: 0).
+    /// Total contact force.
     pub contact_force: f64,
+}
+
+/// JSON has no NaN or infinity: serde_json writes them as null (e.g. the wall
+/// clearance of a rod with no interior extremum); read null back as NaN.
+fn null_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    use serde::Deserialize;
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 impl Scalars {
@@ -107,7 +118,7 @@ impl Scalars {
             stable: e.stable,
             good_knot: e.good_knot,
             iterations: e.iterations,
-            contact_force: 0.0,
+            contact_force: e.contact_force,
         }
     }
 }
@@ -431,9 +442,28 @@ pub fn scene_update(e: &Equilibrium, diameter: f64, stamp: Option<Timestamp>) ->
             color: Some(colour(0.6, 0.7, 0.9, 0.15)),
         });
     }
+    // contact points: red cubes whose size grows with the force
+    let mut contacts = entity("contacts");
+    let (_, arc) = e.state.centreline();
+    let largest = e.contacts.iter().map(|c| c.force).fold(0.0, f64::max);
+    for c in &e.contacts {
+        let k = arc.partition_point(|a| *a <= c.s).clamp(1, arc.len() - 1);
+        let t = ((c.s - arc[k - 1]) / (arc[k] - arc[k - 1]).max(1e-300)).clamp(0.0, 1.0);
+        let at = points[k - 1] + t * (points[k] - points[k - 1]);
+        let size = diameter * (1.5 + 2.0 * c.force / largest.max(1e-300));
+        contacts.cubes.push(CubePrimitive {
+            pose: Some(identity_pose(at)),
+            size: Some(FgVector3 {
+                x: size,
+                y: size,
+                z: size,
+            }),
+            color: Some(colour(0.9, 0.1, 0.1, 0.9)),
+        });
+    }
     SceneUpdate {
         deletions: vec![],
-        entities: vec![rod, frame, clamps, rays, walls],
+        entities: vec![rod, frame, clamps, rays, walls, contacts],
     }
 }
 

@@ -432,7 +432,11 @@ fn figure_3_table(d: &Scene) -> Result<String> {
 }
 
 fn island_table(scenes: &Path) -> Result<String> {
-    let scene = Scene::load(&scenes.join("fig7_island_kirchhoff.toml"))?;
+    island_table_of(scenes, "fig7_island_kirchhoff")
+}
+
+fn island_table_of(scenes: &Path, name: &str) -> Result<String> {
+    let scene = Scene::load(&scenes.join(format!("{name}.toml")))?;
     let spec = scene.map.clone().context("fig7 scene has no [map]")?;
     let cont = scene
         .continuation
@@ -443,11 +447,11 @@ fn island_table(scenes: &Path) -> Result<String> {
     let indices: Vec<usize> = (0..spec.lines).collect();
     let lines = crate::map::compute_lines(&scene, &spec, &indices, None, &cache, &|_| {})?;
     let _ = std::fs::remove_dir_all(&cache);
-    let map = crate::map::assemble("fig7_island_kirchhoff", &spec, cont.range, lines);
+    let map = crate::map::assemble(name, &spec, cont.range, lines);
     let mut s = String::new();
     writeln!(
         s,
-        "Command: `cargo run --release -- map scenes/fig7_island_kirchhoff.toml` (N = {}, {} lines).\n",
+        "Command: `cargo run --release -- map scenes/{name}.toml` (N = {}, {} lines).\n",
         scene.model.segments, spec.lines
     )?;
     writeln!(
@@ -473,7 +477,7 @@ fn island_table(scenes: &Path) -> Result<String> {
     let bb = &map.bounding_box;
     writeln!(
         s,
-        "\nGood knots for z* in [{:.3}, {:.3}] (lines {:.3} apart) and φ/2π in [{:.4}, {:.4}]; area {:.5} in the (z*, φ/2π) plane. Boundaries met: {}. The paper (Fig. 7-left) bounds the island by the curves S, W1, W2 and X and prints no numbers; Fig. 3 (z* = 0.115) and our Figure 3 events above place its bottom edge, and Figure 6's five branches its drift.",
+        "\nGood knots for z* in [{:.3}, {:.3}] (lines {:.3} apart) and φ/2π in [{:.4}, {:.4}]; area {:.5} in the (z*, φ/2π) plane. Boundaries met: {}.",
         bb.get("z_star").map_or(f64::NAN, |v| v[0]),
         bb.get("z_star").map_or(f64::NAN, |v| v[1]),
         spec.value(1) - spec.value(0),
@@ -485,6 +489,314 @@ fn island_table(scenes: &Path) -> Result<String> {
             .cloned()
             .collect::<Vec<_>>()
             .join(", ")
+    )?;
+    Ok(s)
+}
+
+/// Runs a scene (optionally at another N, with TOML appended) and returns its
+/// equilibria and events.
+fn run_text(
+    text: &str,
+) -> Result<(
+    Vec<crate::equilibrium::Equilibrium>,
+    Vec<crate::branch::Event>,
+)> {
+    let scene = Scene::parse(text)?;
+    let mut eqs = Vec::new();
+    let events = crate::run::run_scene(&scene, None, &mut |e| {
+        eqs.push(e);
+        Ok(())
+    })?;
+    Ok((eqs, events))
+}
+
+fn scene_text(scenes: &Path, file: &str, segments: Option<usize>) -> Result<String> {
+    let text = std::fs::read_to_string(scenes.join(file))?;
+    let text = text
+        .split("[output]")
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    Ok(match segments {
+        Some(n) => text
+            .lines()
+            .map(|l| {
+                if l.starts_with("segments = ") {
+                    format!("segments = {n}")
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n"),
+        None => text,
+    })
+}
+
+fn loading_table(scenes: &Path) -> Result<String> {
+    let mut s = String::new();
+    writeln!(
+        s,
+        "| steps up / down | jump up at φ/2π | jump down at φ/2π |\n|---|---|---|"
+    )?;
+    for (up, down) in [(60, 35), (97, 53)] {
+        let text = scene_text(scenes, "loading_twist_snap.toml", None)?
+            .replace("steps = 60", &format!("steps = {up}"))
+            .replace("steps = 35", &format!("steps = {down}"));
+        let (_, events) = run_text(&text)?;
+        let jumps: Vec<f64> = events
+            .iter()
+            .filter(|e| e.kind == "jump")
+            .map(|e| e.phi_over_2pi)
+            .collect();
+        writeln!(
+            s,
+            "| {up} / {down} | {} | {} |",
+            jumps.first().map_or("—".into(), |v| format!("{v:.5}")),
+            jumps.get(1).map_or("—".into(), |v| format!("{v:.5}"))
+        )?;
+    }
+    Ok(s)
+}
+
+fn strip_table(scenes: &Path) -> Result<String> {
+    let mut s = String::new();
+    writeln!(
+        s,
+        "| N | z* | φ/2π range | good intervals of φ/2π | stable everywhere | largest \\|u2\\| | events fold/branch point |\n|---|---|---|---|---|---|---|"
+    )?;
+    for n in [100, 200] {
+        let (eqs, events) = run_text(&scene_text(scenes, "fig8_strip.toml", Some(n))?)?;
+        let folds = events
+            .iter()
+            .filter(|e| e.kind == "fold" || e.kind == "branch_point")
+            .count();
+        for z in [0.115, 0.150, 0.180, 0.200, 0.215] {
+            let mut pts: Vec<&crate::equilibrium::Equilibrium> =
+                eqs.iter().filter(|e| (e.z_star - z).abs() < 1e-9).collect();
+            pts.sort_by(|a, b| a.phi_over_2pi.total_cmp(&b.phi_over_2pi));
+            let mut intervals = Vec::new();
+            let mut start: Option<f64> = None;
+            let mut last = f64::NAN;
+            for p in &pts {
+                match (p.good_knot, start) {
+                    (true, None) => start = Some(p.phi_over_2pi),
+                    (false, Some(a)) => {
+                        intervals.push(format!("[{a:.3}, {last:.3}]"));
+                        start = None;
+                    }
+                    _ => {}
+                }
+                last = p.phi_over_2pi;
+            }
+            if let Some(a) = start {
+                intervals.push(format!("[{a:.3}, {last:.3}]"));
+            }
+            let u2 = pts.iter().filter_map(|p| p.max_u2).fold(0.0, f64::max);
+            writeln!(
+                s,
+                "| {n} | {z:.3} | [{:.3}, {:.3}] | {} | {} | {u2:.1e} | {folds} |",
+                pts.first().map_or(f64::NAN, |p| p.phi_over_2pi),
+                pts.last().map_or(f64::NAN, |p| p.phi_over_2pi),
+                intervals.join(" "),
+                pts.iter().all(|p| p.stable)
+            )?;
+        }
+    }
+    Ok(s)
+}
+
+fn double_ring_table() -> Result<String> {
+    use crate::model::energy::RodEnergy;
+    use crate::model::rod::{Law, RodModel};
+    let mut s = String::new();
+    writeln!(
+        s,
+        "| N | K at which the double ring's lowest eigenvalue changes sign (K2 = K3 = K) | error against 2 |\n|---|---|---|"
+    )?;
+    for n in [50, 100, 200] {
+        let scene = Scene::parse(&format!(
+            "[model]\nsegments = {n}\n[clamps]\nz_star = 0.0\ndelta = 0.0\nphi_over_2pi = 1.0\n[initial]\nshape = \"double_ring\"\nsteps = 1\n"
+        ))?;
+        let (_, ring, _) = crate::equilibrium::starting_equilibrium(&scene, None)?;
+        let lowest = |k: f64| -> Result<f64> {
+            let energy = RodEnergy::new(RodModel {
+                segments: n,
+                k2: k,
+                k3: k,
+                stretching_stiffness: 640_000.0,
+                law: Law::Kirchhoff,
+            });
+            let mut g = vec![0.0; energy.map.len()];
+            let mut v = vec![0.0; energy.pattern.nnz()];
+            energy.hessian(&ring, &mut g, &mut v);
+            let mut ldlt = crate::solve::sparse::Ldlt::new(&energy.pattern);
+            let sp = crate::stability::lowest_eigenvalues(&energy.pattern, &v, None, 1, &mut ldlt)?;
+            Ok(sp.values[0])
+        };
+        let (mut lo, mut hi) = (1.5, 2.5);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if lowest(mid)? > 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let k = 0.5 * (lo + hi);
+        writeln!(s, "| {n} | {k:.6} | {:.2e} |", k - 2.0)?;
+    }
+    Ok(s)
+}
+
+fn asymptotics_table() -> Result<String> {
+    use crate::asymptotics::{curve_i, curve_ii, max_one_contact_z_star, one_contact_shifts};
+    let mut s = String::new();
+    writeln!(
+        s,
+        "Along Δφ = 0.8 z* (N = 200): the end shifts δ_I, δ_II where the strands pass at c1, c2, against eqs. (6.15), (6.18) with exact coefficients ({:.4}, {:.4}).\n",
+        crate::asymptotics::curve_i_first_order(),
+        crate::asymptotics::curve_i_second_order()
+    )?;
+    writeln!(
+        s,
+        "| z* | Δφ | δ_I numerical | δ_I (6.15) | relative error | δ_II numerical | δ_II (6.18) | relative error |\n|---|---|---|---|---|---|---|---|"
+    )?;
+    for z in [0.08, 0.04, 0.02] {
+        let dphi = 0.8 * z;
+        let (d2, d1) = one_contact_shifts(200, z, dphi)?;
+        let (a1, a2) = (curve_i(z, dphi), curve_ii(z, dphi));
+        writeln!(
+            s,
+            "| {z} | {dphi:.3} | {d1:.6} | {a1:.6} | {:.2e} | {d2:.3e} | {a2:.3e} | {:.2e} |",
+            (d1 - a1) / a1,
+            (d2 - a2) / a2
+        )?;
+    }
+    let zmax = max_one_contact_z_star(100, 0.001, 0.002)?;
+    writeln!(
+        s,
+        "\nLargest z* of the one-contact curve at δ = 0.001 (N = 100, bisection to 0.002): {zmax:.4}; the paper's limit as δ → 0 is 0.223 (the self-contacting planar elastica)."
+    )?;
+    Ok(s)
+}
+
+fn map3_table(scenes: &Path) -> Result<String> {
+    let scene = Scene::load(&scenes.join("fig9_strip_3d.toml"))?;
+    let spec = scene.map.clone().context("fig9 scene has no [map]")?;
+    let slices = spec
+        .slices
+        .clone()
+        .context("fig9 scene has no [map.slices]")?;
+    let cont = scene.continuation.as_ref().context("no [continuation]")?;
+    let mut maps = Vec::new();
+    for k in 0..slices.values.len() {
+        let slice = slices.scene(&scene, k);
+        let sspec = slice.map.clone().unwrap();
+        let cache =
+            std::env::temp_dir().join(format!("knotrod-validate-fig9-{}-{k}", std::process::id()));
+        let idx: Vec<usize> = (0..sspec.lines).collect();
+        let lines = crate::map::compute_lines(&slice, &sspec, &idx, None, &cache, &|_| {})?;
+        let _ = std::fs::remove_dir_all(&cache);
+        maps.push(crate::map::assemble("fig9", &sspec, cont.range, lines));
+    }
+    let m3 = crate::map::assemble_3d("fig9_strip_3d", &slices, maps);
+    let mut s = String::new();
+    writeln!(
+        s,
+        "Command: `cargo run --release -- map scenes/fig9_strip_3d.toml` (N = {}, {} lines per slice).\n",
+        scene.model.segments, spec.lines
+    )?;
+    writeln!(
+        s,
+        "| δ | good area | z* range | φ/2π range |\n|---|---|---|---|"
+    )?;
+    for (m, v) in m3.slices.iter().zip(&m3.slice_values) {
+        let r = |k: &str| {
+            m.bounding_box
+                .get(k)
+                .map_or("—".to_string(), |b| format!("[{:.3}, {:.3}]", b[0], b[1]))
+        };
+        writeln!(
+            s,
+            "| {v} | {:.5} | {} | {} |",
+            m.good_area,
+            r("z_star"),
+            r("phi_over_2pi")
+        )?;
+    }
+    let b = |k: &str| {
+        m3.bounding_box
+            .get(k)
+            .map_or("—".to_string(), |b| format!("[{:.3}, {:.3}]", b[0], b[1]))
+    };
+    writeln!(
+        s,
+        "\nGood volume {:.5} in (δ, z*, φ/2π); bounding box δ {}, z* {}, φ/2π {}. The paper: no good knots outside 0.01 < δ < 0.3, 0.05 < z* < 0.45, 0.02 < 1 − φ/2π < 0.5.",
+        m3.good_volume,
+        b("delta"),
+        b("z_star"),
+        b("phi_over_2pi")
+    )?;
+    Ok(s)
+}
+
+fn contact_table(scenes: &Path) -> Result<String> {
+    let (eqs, events) = run_text(&scene_text(scenes, "trefoil_contact_start.toml", None)?)?;
+    let mut s = String::new();
+    let a = eqs
+        .iter()
+        .find(|e| e.phi_over_2pi.abs() < 1e-12)
+        .context("configuration A")?;
+    writeln!(
+        s,
+        "Command: `cargo run --release -- run scenes/trefoil_contact_start.toml` (N = 100, h = 0.005).\n"
+    )?;
+    writeln!(s, "| quantity | knotrod | paper |\n|---|---|---|")?;
+    let cs: Vec<String> = a
+        .contacts
+        .iter()
+        .map(|c| format!("{} at s = {:.3} (force {:.1})", c.obstacle, c.s, c.force))
+        .collect();
+    writeln!(
+        s,
+        "| A: contacts | {} | two, with the rays, s ≈ 0.17, 0.83 |",
+        cs.join("; ")
+    )?;
+    writeln!(s, "| A: Tw | {:.4} | −0.07 |", a.twist)?;
+    writeln!(s, "| A: link | {:.4} | 3.0 |", a.link)?;
+    writeln!(
+        s,
+        "| A: min self-distance | {:.4} (h = 0.005) | > h |",
+        a.min_self_distance
+    )?;
+    let find = |kind: &str, leg: usize| {
+        events
+            .iter()
+            .filter(|e| e.kind == kind && e.branch == leg)
+            .map(|e| format!("{:.5}", e.phi_over_2pi))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    writeln!(
+        s,
+        "| B: contact force reaches zero (up) | φ/2π = {} | 0.768 |",
+        find("contact_lost", 1)
+    )?;
+    writeln!(
+        s,
+        "| jumps on the way up | φ/2π = {} | at B |",
+        find("jump", 1)
+    )?;
+    writeln!(
+        s,
+        "| C: walls on the way up (W1, W2) | φ/2π = {} | 0.774, 0.82 |",
+        find("wall", 1)
+    )?;
+    writeln!(
+        s,
+        "| back down: jumps | φ/2π = {} | at S (no return to B) |",
+        find("jump", 2)
     )?;
     Ok(s)
 }
@@ -529,6 +841,55 @@ pub fn report(scenes: &Path) -> Result<String> {
         "\n## Figure 7-left: the island of good knots (Kirchhoff rod, δ = 0.05)\n"
     )?;
     s += &island_table(scenes)?;
+    writeln!(
+        s,
+        "\n## Quasi-static loading: a buckled strip-like rod twisted until it snaps\n"
+    )?;
+    writeln!(
+        s,
+        "`scenes/loading_twist_snap.toml` (K2 = 20, K3 = 1.5, z* = 0.8, N = 100): the clamp turned to 1.2 turns and back to 0.5. Jumps are located by bisecting the step to 1e-4 turns, so they do not depend on the step sequence.\n"
+    )?;
+    s += &loading_table(scenes)?;
+    writeln!(
+        s,
+        "\n## Elastic strip: Figure 8 (branches in φ, δ = 0.05)\n"
+    )?;
+    writeln!(
+        s,
+        "`scenes/fig8_strip.toml`: Sadowsky law with u2 = 0 enforced (SQP, clarabel QPs polished on the KKT system), started from the double ring unfolded into the knotted wedge, continued on the KKT system. Good = walled, trefoil, stable, self-distance > h. Paper: a stable walled knotted strip with no self-contact at z* = 0.215, φ/2π ≈ 0.94; no pitchfork, branches down to φ/2π < 0.5.\n"
+    )?;
+    s += &strip_table(scenes)?;
+    writeln!(
+        s,
+        "\nAt z* ≥ 0.17 the good set of one branch splits in two: the strands pass through each other twice inside the walled range (two crossings X between which the centreline is unknotted). The split is present at N = 100 and N = 200 alike; the island map below shows it as a notch from the top of the island."
+    )?;
+    writeln!(
+        s,
+        "\n## Figure 7-right: the island of good knots (elastic strip, δ = 0.05)\n"
+    )?;
+    s += &island_table_of(scenes, "fig7_island_strip")?;
+    writeln!(
+        s,
+        "\nThe strip's island is larger than the rod's (area and φ range), as the paper finds. Its boundaries: W1 below-left, W2 right, the crossing curves X above. Beyond the paper's description (W1, W2, X1, X2) the computation finds a notch: an unknotted wedge bounded by two crossing curves that enters the island from above at z* ≈ 0.17 and splits the good interval of each z* above into two (see the Figure 8 table, same at N = 200)."
+    )?;
+    writeln!(s, "\n## Figure 9: good knots of the strip in (δ, z*, φ)\n")?;
+    s += &map3_table(scenes)?;
+    writeln!(s, "\n## The double ring's stability (criterion 2.7)\n")?;
+    writeln!(
+        s,
+        "The Kirchhoff double ring (z* = δ = 0, φ = 2π) is stable iff sqrt((K2 − 1)/K2 · (K3 − 1)/K3) ≥ 1/2, i.e. K ≥ 2 for K2 = K3 = K. The sign change of its lowest Hessian eigenvalue, located by bisection in K:\n"
+    )?;
+    s += &double_ring_table()?;
+    writeln!(
+        s,
+        "\n## Near the double ring: curves I and II (Figure 13)\n"
+    )?;
+    s += &asymptotics_table()?;
+    writeln!(
+        s,
+        "\n## Contact: the trefoil on the rays, A → B → C (Figures 3-5)\n"
+    )?;
+    s += &contact_table(scenes)?;
     writeln!(s, "\n## Convergence in N, Appendix D\n")?;
     writeln!(
         s,

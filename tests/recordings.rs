@@ -296,3 +296,50 @@ fn damaged_recordings_give_clear_errors() {
     let e = read_state(&rec, 10_000).err().unwrap().to_string();
     assert!(e.contains("no state with index 10000"), "{e}");
 }
+
+#[test]
+fn contacts_are_recorded_and_drawn() {
+    // a clamped beam pushed by a segment obstacle: one contact, drawn as a
+    // red cube at the contact point, its force in the scalars
+    let dir = temp("contacts");
+    let scene = dir.join("beam.toml");
+    std::fs::write(
+        &scene,
+        "[model]\nsegments = 40\n[clamps]\nz_star = 1.0\ndelta = 0.0\nphi_over_2pi = 0.0\n\
+         [contact]\nrays = false\nself_contact = false\n\
+         obstacles = [[0.0049, -0.1, 0.5, 0.0049, 0.1, 0.5]]\n",
+    )
+    .unwrap();
+    let rec = dir.join("beam.mcap");
+    let out = knotrod(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--record",
+        rec.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(&rec).unwrap();
+    let mut drawn = 0;
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        if m.channel.topic == SCENE_TOPIC {
+            let u =
+                <foxglove::messages::SceneUpdate as prost::Message>::decode(&m.data[..]).unwrap();
+            let c = u.entities.iter().find(|e| e.id == "contacts").unwrap();
+            assert_eq!(c.cubes.len(), 1);
+            let at = c.cubes[0].pose.as_ref().unwrap().position.as_ref().unwrap();
+            assert!(
+                (at.z - 0.5).abs() < 1e-9 && (at.x + 1e-4).abs() < 1e-6,
+                "{at:?}"
+            );
+            drawn += 1;
+        }
+    }
+    assert_eq!(drawn, 1);
+    let r = read_recording(&rec).unwrap();
+    assert!(r.scalars[0].contact_force > 0.0);
+}

@@ -401,11 +401,12 @@ pub fn minimize(
         // equalities, their forces from the small Schur complement G P⁻¹ Gᵀ
         // (one sparse solve per active contact)
         let mut z = z;
-        if m_eq == 0 && !gaps.is_empty() {
-            if let Some((dp, zp)) = polish_contacts(newton, &q, &gap_rows, &gaps, &z) {
-                d = dp;
-                z = zp;
-            }
+        if m_eq == 0
+            && !gaps.is_empty()
+            && let Some((dp, zp)) = polish_contacts(newton, &q, &gap_rows, &gaps, &z)
+        {
+            d = dp;
+            z = zp;
         }
         forces = gaps
             .iter()
