@@ -405,8 +405,18 @@ pub fn minimize(
             && !gaps.is_empty()
             && let Some((dp, zp)) = polish_contacts(newton, &q, &gap_rows, &gaps, &z)
         {
-            d = dp;
-            z = zp;
+            // keep the polish only if it is at least as good a QP solution
+            // (a wrong active set from an inexact interior point would not be)
+            let objective = |x: &[f64]| {
+                let mut px = vec![0.0; n];
+                newton.energy.pattern.mul_vec(&values, x, &mut px);
+                0.5 * x.iter().zip(&px).map(|(a, b)| a * b).sum::<f64>()
+                    + x.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>()
+            };
+            if objective(&dp) <= objective(&d) + 1e-12 * objective(&d).abs() {
+                d = dp;
+                z = zp;
+            }
         }
         forces = gaps
             .iter()
@@ -438,6 +448,14 @@ pub fn minimize(
         let merit0 = merit_info.energy + contact_penalty(state);
         let slope: f64 = step.iter().zip(&grad).map(|(s, g)| s * g).sum::<f64>()
             - mu * gaps.iter().map(|g| (-g.gap).max(0.0)).sum::<f64>();
+        if slope >= 0.0 && rel > 1e3 * settings.gradient_tol {
+            // not a descent direction (an inexact QP solution with a wrong
+            // active set): say so now rather than creep
+            return Err(SolveError::LineSearch {
+                iteration: it,
+                residual: rel,
+            });
+        }
         let mut alpha = 1.0;
         let mut accepted = false;
         let mut trial_step = vec![0.0; n];
@@ -483,18 +501,6 @@ pub fn minimize(
                 iteration: it,
                 residual: rel,
             });
-        }
-        if std::env::var("KNOTROD_DEBUG_SQP").is_ok() && it % 50 == 0 {
-            eprintln!(
-                "it {it} rel {rel:.3e} pen {penetration:.2e} alpha {alpha} |d| {largest:.2e} gaps {} active {} z {:?}",
-                gaps.len(),
-                forces.iter().filter(|f| f.1 > 0.0).count(),
-                forces
-                    .iter()
-                    .map(|f| f.1)
-                    .filter(|z| *z > 0.0)
-                    .collect::<Vec<_>>()
-            );
         }
         std::mem::swap(state, &mut trial);
     }
