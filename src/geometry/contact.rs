@@ -163,7 +163,26 @@ impl ContactModel {
                 }
             }
         }
-        out
+        // rows of neighbouring segments whose closest points coincide (at a
+        // shared node) are the same constraint: keep one, or the QP's rows
+        // are exactly dependent
+        let mut kept: Vec<Gap> = Vec::with_capacity(out.len());
+        for g in out {
+            let dup = kept.iter().any(|k| {
+                std::mem::discriminant(&k.obstacle) == std::mem::discriminant(&g.obstacle)
+                    && (k.gap - g.gap).abs() < 1e-14
+                    && (k.s - g.s).abs() < 1e-12
+                    && match (k.obstacle, g.obstacle) {
+                        (Obstacle::SelfAt(a), Obstacle::SelfAt(b)) => (a - b).abs() < 1e-12,
+                        (Obstacle::Fixed(a), Obstacle::Fixed(b)) => a == b,
+                        _ => true,
+                    }
+            });
+            if !dup {
+                kept.push(g);
+            }
+        }
+        kept
     }
 
     /// The gap of a candidate (same segments and obstacle) at another state.

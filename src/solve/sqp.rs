@@ -114,7 +114,7 @@ fn qp_settings() -> DefaultSettings<f64> {
     DefaultSettings {
         verbose: false,
         presolve_enable: false,
-        max_iter: 50,
+        max_iter: 200,
         ..DefaultSettings::default()
     }
 }
