@@ -420,7 +420,7 @@ pub fn analyse_from(
     let stable = plain.negative_count == 0 && plain.values.first().is_none_or(|v| *v > 0.0);
     let shape = Shape::measure(state, measure, previous);
     let twist = state.twist();
-    let walled = min_z > 0.0 && max_z < z_star;
+    let walled = state.walled();
     let min_self_distance = shape.self_approach.map_or(f64::INFINITY, |a| a.distance);
     let law = newton.energy.model.law;
     let strains: Vec<[f64; 3]> = if law.constrained() {

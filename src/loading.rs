@@ -165,6 +165,43 @@ pub fn carry(
     })
 }
 
+/// Bisect the clamp move from the equilibrium `from` (where `same` holds) to
+/// `to` (where it fails) down to [`JUMP_LOCATION`]: the last state where it
+/// holds and the first clamps where it fails.
+fn locate_on_path(
+    newton: &mut Newton,
+    from: &RodState,
+    to: Clamps,
+    settings: &NewtonSettings,
+    same: &mut dyn FnMut(&mut Newton, &Step) -> Result<bool>,
+) -> Result<(RodState, Clamps)> {
+    let (mut lo, mut hi) = (from.clone(), to);
+    while clamp_gap(&lo.clamps, &hi) > JUMP_LOCATION {
+        let mid = midpoint(&lo.clamps, &hi);
+        let trial = carry(newton, &lo, mid, settings)?;
+        if same(newton, &trial)? {
+            lo = trial.state;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok((lo, hi))
+}
+
+/// An event of a loading path at clamps `c` (its `branch` is the path's leg).
+fn path_event(kind: &str, c: &Clamps, twist: f64, leg: usize, detail: String) -> Event {
+    Event {
+        kind: kind.into(),
+        label: String::new(),
+        phi_over_2pi: c.phi_over_2pi(),
+        z_star: c.z_star,
+        delta: c.delta,
+        twist,
+        branch: leg,
+        detail,
+    }
+}
+
 /// Link change between two equilibria beyond the clamp's own turn.
 fn link_jump(a: &crate::equilibrium::Equilibrium, b: &crate::equilibrium::Equilibrium) -> f64 {
     b.link - a.link - (eq_clamps(b).phi - eq_clamps(a).phi) / (2.0 * std::f64::consts::PI)
@@ -222,42 +259,35 @@ pub fn run_loading(
             let mut next = analyse_from(newton, &step.state, &step.report, measure, Some(&eq))?;
             if step.jumped || link_jump(&eq, &next).abs() > JUMP_LINK {
                 // a hand moves slowly: the rod jumps where its branch ends, not
-                // where a finite step happened to overshoot; bisect the step
-                let (mut lo_state, mut lo_eq, mut hi) = (state.clone(), eq.clone(), c);
-                while clamp_gap(&lo_state.clamps, &hi) > JUMP_LOCATION {
-                    let mid = midpoint(&lo_state.clamps, &hi);
-                    let trial = carry(newton, &lo_state, mid, settings).with_context(context)?;
-                    let trial_eq =
-                        analyse_from(newton, &trial.state, &trial.report, measure, Some(&lo_eq))?;
-                    if trial.jumped || link_jump(&lo_eq, &trial_eq).abs() > JUMP_LINK {
-                        hi = mid;
-                    } else {
-                        (lo_state, lo_eq) = (trial.state, trial_eq);
+                // where a finite step happened to overshoot
+                let mut lo_eq = eq.clone();
+                let (lo_state, hi) = locate_on_path(newton, &state, c, settings, &mut |nw, t| {
+                    let t_eq = analyse_from(nw, &t.state, &t.report, measure, Some(&lo_eq))?;
+                    let same = !t.jumped && link_jump(&lo_eq, &t_eq).abs() <= JUMP_LINK;
+                    if same {
+                        lo_eq = t_eq;
                     }
-                }
+                    Ok(same)
+                })
+                .with_context(context)?;
                 // the last step from the end of the branch jumps; the rod then
                 // moves on from where it landed to this step's clamps
                 let landed = carry(newton, &lo_state, hi, settings).with_context(context)?;
                 let landed_eq =
                     analyse_from(newton, &landed.state, &landed.report, measure, Some(&lo_eq))?;
-                let jump_link = link_jump(&lo_eq, &landed_eq);
-                if landed.jumped || jump_link.abs() > JUMP_LINK {
-                    events.push(Event {
+                if landed.jumped || link_jump(&lo_eq, &landed_eq).abs() > JUMP_LINK {
+                    events.push(path_event(
                         // the link changes by ±2 without a jump when the
                         // centreline passes through itself (no contact model)
-                        kind: if landed.jumped { "jump" } else { "crossing" }.into(),
-                        label: String::new(),
-                        phi_over_2pi: hi.phi_over_2pi(),
-                        z_star: hi.z_star,
-                        delta: hi.delta,
-                        twist: lo_eq.twist,
-                        // for a loading path, the leg of the path
-                        branch: leg,
-                        detail: format!(
+                        if landed.jumped { "jump" } else { "crossing" },
+                        &hi,
+                        lo_eq.twist,
+                        leg,
+                        format!(
                             "lands {:.4} from the prediction, link {:.3} → {:.3}, twist {:.3} → {:.3}",
                             landed.miss, lo_eq.link, landed_eq.link, lo_eq.twist, landed_eq.twist
                         ),
-                    });
+                    ));
                     step = carry(newton, &landed.state, c, settings).with_context(context)?;
                     next =
                         analyse_from(newton, &step.state, &step.report, measure, Some(&landed_eq))?;
@@ -265,63 +295,26 @@ pub fn run_loading(
             }
             if eq.walled != next.walled && !step.jumped {
                 // entering or leaving the walls: locate it on the branch
-                let walled = |st: &RodState| {
-                    let (lo, hi) = st.z_range();
-                    lo > 0.0 && hi < st.clamps.z_star
-                };
                 let inside = eq.walled;
-                let (mut lo_state, mut hi) = (state.clone(), c);
-                while clamp_gap(&lo_state.clamps, &hi) > JUMP_LOCATION {
-                    let mid = midpoint(&lo_state.clamps, &hi);
-                    let trial = carry(newton, &lo_state, mid, settings).with_context(context)?;
-                    if walled(&trial.state) == inside {
-                        lo_state = trial.state;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                events.push(Event {
-                    kind: "wall".into(),
-                    label: String::new(),
-                    phi_over_2pi: hi.phi_over_2pi(),
-                    z_star: hi.z_star,
-                    delta: hi.delta,
-                    twist: eq.twist,
-                    branch: leg,
-                    detail: if inside {
-                        "leaves the walls"
-                    } else {
-                        "enters the walls"
-                    }
-                    .into(),
-                });
+                let (_, hi) = locate_on_path(newton, &state, c, settings, &mut |_, t| {
+                    Ok(t.state.walled() == inside)
+                })
+                .with_context(context)?;
+                let detail = if inside { "leaves the walls" } else { "enters the walls" };
+                events.push(path_event("wall", &hi, eq.twist, leg, detail.into()));
             }
             if !eq.contacts.is_empty() && next.contacts.is_empty() {
                 // the last contact opens: locate where its force reaches zero
-                let (mut lo_state, mut hi) = (state.clone(), c);
-                while clamp_gap(&lo_state.clamps, &hi) > JUMP_LOCATION {
-                    let mid = midpoint(&lo_state.clamps, &hi);
-                    let trial = carry(newton, &lo_state, mid, settings).with_context(context)?;
-                    if trial.report.contacts.is_empty() {
-                        hi = mid;
-                    } else {
-                        lo_state = trial.state;
-                    }
-                }
-                events.push(Event {
-                    kind: "contact_lost".into(),
-                    label: String::new(),
-                    phi_over_2pi: hi.phi_over_2pi(),
-                    z_star: hi.z_star,
-                    delta: hi.delta,
-                    twist: eq.twist,
-                    branch: leg,
-                    detail: format!(
-                        "contacts {} → none (total force {:.3} before)",
-                        eq.contacts.len(),
-                        eq.contact_force
-                    ),
-                });
+                let (_, hi) = locate_on_path(newton, &state, c, settings, &mut |_, t| {
+                    Ok(!t.report.contacts.is_empty())
+                })
+                .with_context(context)?;
+                let detail = format!(
+                    "contacts {} → none (total force {:.3} before)",
+                    eq.contacts.len(),
+                    eq.contact_force
+                );
+                events.push(path_event("contact_lost", &hi, eq.twist, leg, detail));
             }
             observer(next.clone())?;
             state = step.state;

@@ -406,6 +406,12 @@ impl RodState {
             })
     }
 
+    /// Walled: every interior node strictly between the planes z = 0 and z = z*.
+    pub fn walled(&self) -> bool {
+        let (lo, hi) = self.z_range();
+        lo > 0.0 && hi < self.clamps.z_star
+    }
+
     /// Move the s = 1 clamp to new parameters: the two clamp nodes translate, the
     /// clamp angle becomes φ; interior dofs are kept.
     pub fn set_clamps(&mut self, clamps: Clamps) {
