@@ -46,12 +46,12 @@ pub fn settle(
     settings: &NewtonSettings,
 ) -> Result<crate::solve::newton::NewtonReport> {
     let mut report = newton.minimize(state, settings)?;
-    if !report.contacts.is_empty() {
-        // held by contacts: a minimum of the constrained problem (its
+    for _ in 0..=8 {
+        // held by contacts, it is a minimum of the constrained problem (its
         // stability is judged on the contacts' tangent space by `analyse`)
-        return Ok(report);
-    }
-    for _ in 0..8 {
+        if !report.contacts.is_empty() {
+            return Ok(report);
+        }
         let (neg, mode) = inertia(newton, state, true)?;
         if neg == 0 {
             return Ok(report);
@@ -76,9 +76,6 @@ pub fn settle(
         let (_, s, r) = best.unwrap();
         *state = s;
         report = r;
-        if !report.contacts.is_empty() {
-            return Ok(report);
-        }
     }
     bail!("could not reach a stable equilibrium from a saddle")
 }
@@ -300,7 +297,11 @@ pub fn run_loading(
                     Ok(t.state.walled() == inside)
                 })
                 .with_context(context)?;
-                let detail = if inside { "leaves the walls" } else { "enters the walls" };
+                let detail = if inside {
+                    "leaves the walls"
+                } else {
+                    "enters the walls"
+                };
                 events.push(path_event("wall", &hi, eq.twist, leg, detail.into()));
             }
             if !eq.contacts.is_empty() && next.contacts.is_empty() {

@@ -107,9 +107,10 @@ impl LinOp<f64> for ShiftInvert<'_> {
 fn lanczos_largest(op: &ShiftInvert<'_>, k: usize, min_steps: usize) -> Vec<(f64, Vec<f64>)> {
     let dim = op.reduced.len();
     let max_steps = (4 * k + 40).max(min_steps).min(dim);
-    let apply = |x: &[f64], y: &mut [f64]| {
+    let mut b = vec![0.0; op.full_dim];
+    let mut apply = |x: &[f64], y: &mut [f64]| {
         let mut ldlt = op.ldlt.lock().unwrap();
-        let mut b = vec![0.0; op.full_dim];
+        b.iter_mut().for_each(|v| *v = 0.0);
         for (kk, &d) in op.reduced.iter().enumerate() {
             b[d] = op.weight[kk] * x[kk];
         }

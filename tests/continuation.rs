@@ -16,6 +16,18 @@ fn run(scene: &Scene) -> (Vec<Equilibrium>, Vec<Event>) {
     (eqs, events)
 }
 
+/// Every state of a loading path a converged minimum; its jumps.
+fn converged_minima_and_jumps<'a>(eqs: &[Equilibrium], events: &'a [Event]) -> Vec<&'a Event> {
+    for e in eqs {
+        assert!(
+            e.converged && e.negative_eigenvalues == 0,
+            "not a converged minimum at φ/2π = {}",
+            e.phi_over_2pi
+        );
+    }
+    events.iter().filter(|e| e.kind == "jump").collect()
+}
+
 /// A paper scene at another N with extra TOML appended.
 fn paper_scene(file: &str, segments: usize, extra: &str) -> Scene {
     let text = std::fs::read_to_string(file).unwrap();
@@ -38,14 +50,7 @@ fn rotating_the_clamp_down_past_s_jumps_and_does_not_come_back() {
     );
     let (eqs, events) = run(&scene);
     assert_eq!(eqs.len(), 102);
-    for e in &eqs {
-        assert!(
-            e.converged && e.negative_eigenvalues == 0,
-            "not a converged minimum at φ/2π = {}",
-            e.phi_over_2pi
-        );
-    }
-    let jumps: Vec<&Event> = events.iter().filter(|e| e.kind == "jump").collect();
+    let jumps = converged_minima_and_jumps(&eqs, &events);
     assert_eq!(jumps.len(), 1, "{events:?}");
     assert_eq!(jumps[0].branch, 0, "the jump happens on the way down");
     assert!(
@@ -231,14 +236,7 @@ fn twist_snap(up: usize, down: usize) -> (Vec<Equilibrium>, Vec<Event>) {
 fn twisting_a_buckled_rod_snaps_at_two_different_angles() {
     let (eqs, events) = twist_snap(60, 35);
     assert_eq!(eqs.len(), 96);
-    for e in &eqs {
-        assert!(
-            e.converged && e.negative_eigenvalues == 0,
-            "not a converged minimum at φ/2π = {}",
-            e.phi_over_2pi
-        );
-    }
-    let jumps: Vec<&Event> = events.iter().filter(|e| e.kind == "jump").collect();
+    let jumps = converged_minima_and_jumps(&eqs, &events);
     assert_eq!(jumps.len(), 2, "{events:?}");
     let (up, down) = (jumps[0], jumps[1]);
     assert_eq!((up.branch, down.branch), (0, 1), "one jump each way");

@@ -21,6 +21,22 @@ fn temp(name: &str) -> PathBuf {
     dir
 }
 
+/// Run a scene recording to `rec`; the recording's bytes.
+fn run_recorded(scene: &Path, rec: &Path) -> Vec<u8> {
+    let out = knotrod(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--record",
+        rec.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::read(rec).unwrap()
+}
+
 /// A short branch of the Figure 3 problem at N = 40.
 fn short_branch_scene(dir: &Path, extra: &str) -> PathBuf {
     let text = std::fs::read_to_string("scenes/appendix_d.toml")
@@ -41,18 +57,7 @@ fn recording_has_foxglove_schemas_and_every_message_decodes() {
     let dir = temp("schemas");
     let scene = short_branch_scene(&dir, "");
     let rec = dir.join("run.mcap");
-    let out = knotrod(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--record",
-        rec.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let bytes = std::fs::read(&rec).unwrap();
+    let bytes = run_recorded(&scene, &rec);
     let summary = mcap::Summary::read(&bytes)
         .unwrap()
         .expect("finalised with a summary");
@@ -311,18 +316,7 @@ fn contacts_are_recorded_and_drawn() {
     )
     .unwrap();
     let rec = dir.join("beam.mcap");
-    let out = knotrod(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--record",
-        rec.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let bytes = std::fs::read(&rec).unwrap();
+    let bytes = run_recorded(&scene, &rec);
     let mut drawn = 0;
     for m in mcap::MessageStream::new(&bytes).unwrap() {
         let m = m.unwrap();

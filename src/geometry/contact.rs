@@ -185,10 +185,9 @@ impl ContactModel {
         kept
     }
 
-    /// The gap of a candidate (same segments and obstacle) at another state.
-    pub fn gap_at(&self, state: &RodState, c: &Gap) -> f64 {
-        let (points, _) = state.centreline();
-        let h = self.diameter;
+    /// The gap of a candidate (same segments and obstacle) for the centreline
+    /// `points` of another state.
+    pub fn gap_at(&self, points: &[Vector3<f64>], c: &Gap) -> f64 {
         let k = c.segments[0];
         let other = match c.obstacle {
             Obstacle::RayBottom => [Vector3::zeros(), -self.ray_length * Vector3::z()],
@@ -199,7 +198,11 @@ impl ContactModel {
             Obstacle::Fixed(o) => self.obstacles[o],
             Obstacle::SelfAt(_) => [points[c.segments[1]], points[c.segments[1] + 1]],
         };
-        pair_gap(&[points[k], points[k + 1], other[0], other[1]], h).0
+        pair_gap(
+            &[points[k], points[k + 1], other[0], other[1]],
+            self.diameter,
+        )
+        .0
     }
 }
 

@@ -86,61 +86,78 @@ impl<'a> CurveTree<'a> {
 }
 
 impl CurveTree<'_> {
-    /// Segment pairs (i < j), at least `gap` apart in arc length, closer than
-    /// `within`.
-    pub fn pairs_within(&self, arc: &[f64], gap: f64, within: f64) -> Vec<(usize, usize)> {
-        let mut out = Vec::new();
+    /// Visit the segment pairs (i < j) at least `gap` apart in arc length
+    /// whose runs are not pruned: `prune(d)` is asked with the distance
+    /// between two runs' boxes (nearest run pairs are visited first, so a
+    /// shrinking bound prunes early); `leaf(i, j)` gets every surviving pair.
+    fn walk_pairs(
+        &self,
+        arc: &[f64],
+        gap: f64,
+        prune: &dyn Fn(f64) -> bool,
+        leaf: &mut dyn FnMut(usize, usize),
+    ) {
         if self.nodes.is_empty() {
-            return out;
+            return;
         }
-        let points = self.points;
         let mut stack = vec![(0usize, 0usize)];
         while let Some((a, b)) = stack.pop() {
             let (na, nb) = (&self.nodes[a], &self.nodes[b]);
-            if arc[nb.hi - 1] - arc[na.lo + 1] < gap || aabb_distance(&na.aabb, &nb.aabb) >= within
-            {
+            // largest separation available between the two runs (a before b)
+            if arc[nb.hi - 1] - arc[na.lo + 1] < gap || prune(aabb_distance(&na.aabb, &nb.aabb)) {
                 continue;
             }
             match (na.children, nb.children) {
                 (None, None) => {
                     for i in na.lo..na.hi {
                         for j in nb.lo.max(i + 1)..nb.hi {
-                            if arc[j] - arc[i + 1] < gap {
-                                continue;
-                            }
-                            let (d, _, _) = segment_distance(
-                                &points[i],
-                                &points[i + 1],
-                                &points[j],
-                                &points[j + 1],
-                            );
-                            if d < within {
-                                out.push((i, j));
+                            if arc[j] - arc[i + 1] >= gap {
+                                leaf(i, j);
                             }
                         }
                     }
                 }
                 _ => {
+                    // split the larger run (a self pair splits into three pairs)
                     let split_a = match (na.children, nb.children) {
                         (Some(_), None) => true,
                         (None, Some(_)) => false,
                         _ => na.hi - na.lo >= nb.hi - nb.lo,
                     };
-                    if a == b {
+                    let mut pairs: Vec<(usize, usize)> = if a == b {
                         let (l, r) = na.children.unwrap();
-                        stack.extend([(l, l), (l, r), (r, r)]);
+                        vec![(l, l), (l, r), (r, r)]
                     } else if split_a {
                         let (l, r) = na.children.unwrap();
-                        stack.extend([(l, b), (r, b)]);
+                        vec![(l, b), (r, b)]
                     } else {
                         let (l, r) = nb.children.unwrap();
-                        stack.extend([(a, l), (a, r)]);
-                    }
+                        vec![(a, l), (a, r)]
+                    };
+                    // visit the nearest pair first (pushed last)
+                    pairs.sort_by(|p, q| {
+                        let dp = aabb_distance(&self.nodes[p.0].aabb, &self.nodes[p.1].aabb);
+                        let dq = aabb_distance(&self.nodes[q.0].aabb, &self.nodes[q.1].aabb);
+                        dq.total_cmp(&dp)
+                    });
+                    stack.extend(pairs);
                 }
             }
         }
-        out.sort_unstable();
-        out.dedup();
+    }
+
+    /// Segment pairs (i < j), at least `gap` apart in arc length, closer than
+    /// `within`.
+    pub fn pairs_within(&self, arc: &[f64], gap: f64, within: f64) -> Vec<(usize, usize)> {
+        let points = self.points;
+        let mut out = Vec::new();
+        self.walk_pairs(arc, gap, &|d| d >= within, &mut |i, j| {
+            let (d, _, _) =
+                segment_distance(&points[i], &points[i + 1], &points[j], &points[j + 1]);
+            if d < within {
+                out.push((i, j));
+            }
+        });
         out
     }
 }
@@ -174,63 +191,15 @@ fn approach(points: &[Vector3<f64>], arc: &[f64], i: usize, j: usize) -> Approac
 /// to the start of the second) is at least `gap`. None if no pair qualifies.
 pub fn min_self_distance(points: &[Vector3<f64>], arc: &[f64], gap: f64) -> Option<Approach> {
     let tree = CurveTree::new(points);
-    if tree.nodes.is_empty() {
-        return None;
-    }
     let mut best: Option<Approach> = None;
-    let mut bound = f64::INFINITY;
-    let mut stack = vec![(0usize, 0usize)];
-    while let Some((a, b)) = stack.pop() {
-        let (na, nb) = (&tree.nodes[a], &tree.nodes[b]);
-        // largest separation available between the two runs (a before b)
-        if arc[nb.hi - 1] - arc[na.lo + 1] < gap {
-            continue;
+    let bound = std::cell::Cell::new(f64::INFINITY);
+    tree.walk_pairs(arc, gap, &|d| d >= bound.get(), &mut |i, j| {
+        let a = approach(points, arc, i, j);
+        if a.distance < bound.get() {
+            bound.set(a.distance);
+            best = Some(a);
         }
-        if aabb_distance(&na.aabb, &nb.aabb) >= bound {
-            continue;
-        }
-        match (na.children, nb.children) {
-            (None, None) => {
-                for i in na.lo..na.hi {
-                    for j in nb.lo.max(i + 1)..nb.hi {
-                        if arc[j] - arc[i + 1] < gap {
-                            continue;
-                        }
-                        let a = approach(points, arc, i, j);
-                        if a.distance < bound {
-                            bound = a.distance;
-                            best = Some(a);
-                        }
-                    }
-                }
-            }
-            _ => {
-                // split the larger run (a self pair splits into three pairs)
-                let split_a = match (na.children, nb.children) {
-                    (Some(_), None) => true,
-                    (None, Some(_)) => false,
-                    _ => na.hi - na.lo >= nb.hi - nb.lo,
-                };
-                let mut pairs: Vec<(usize, usize)> = if a == b {
-                    let (l, r) = na.children.unwrap();
-                    vec![(l, l), (l, r), (r, r)]
-                } else if split_a {
-                    let (l, r) = na.children.unwrap();
-                    vec![(l, b), (r, b)]
-                } else {
-                    let (l, r) = nb.children.unwrap();
-                    vec![(a, l), (a, r)]
-                };
-                // visit the nearest pair first (pushed last) to tighten the bound early
-                pairs.sort_by(|p, q| {
-                    let dp = aabb_distance(&tree.nodes[p.0].aabb, &tree.nodes[p.1].aabb);
-                    let dq = aabb_distance(&tree.nodes[q.0].aabb, &tree.nodes[q.1].aabb);
-                    dq.total_cmp(&dp)
-                });
-                stack.extend(pairs);
-            }
-        }
-    }
+    });
     best
 }
 

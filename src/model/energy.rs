@@ -105,6 +105,17 @@ fn vertex_chain(a: usize) -> [(usize, f64); 2] {
     }
 }
 
+/// Map an 8-variable gradient to the 11 node variables.
+fn vertex_gradient_to_nodes(g8: &[f64]) -> [f64; 11] {
+    let mut g = [0.0; 11];
+    for (a, ga) in g.iter_mut().enumerate() {
+        for &(k, alpha) in vertex_chain(a).iter().filter(|c| c.0 != usize::MAX) {
+            *ga += alpha * g8[k];
+        }
+    }
+    g
+}
+
 /// Map an 8-variable gradient and Hessian to the 11 node variables.
 fn vertex_to_nodes(g8: &[f64], h8: &[f64]) -> ([f64; 11], [f64; 121]) {
     let mut g = [0.0; 11];
@@ -355,21 +366,21 @@ impl RodEnergy {
     /// The constraints κ2_i = h u2_i (i = 1..=N) and their gradients on the
     /// 11 node variables of vertex i's stencil.
     pub fn constraint_rows(&self, state: &RodState) -> Vec<(f64, [f64; 11])> {
-        (1..=self.model.segments)
-            .map(|i| {
-                let c = VertexFrames::at(state, i);
-                let q = SVector::<f64, 8>::from(vertex_variables(state, i));
-                let (v, g8) =
-                    num_dual::gradient(|v: SVector<_, 8>| normal_curvature(v.as_slice(), &c), &q);
-                let mut g = [0.0; 11];
-                for (a, ga) in g.iter_mut().enumerate() {
-                    for &(k, alpha) in vertex_chain(a).iter().filter(|c| c.0 != usize::MAX) {
-                        *ga += alpha * g8[k];
-                    }
-                }
-                (v, g)
-            })
-            .collect()
+        let mut rows = Vec::with_capacity(self.model.segments);
+        self.constraint_rows_into(state, &mut rows);
+        rows
+    }
+
+    /// As [`Self::constraint_rows`], into `rows` (its allocation reused).
+    pub fn constraint_rows_into(&self, state: &RodState, rows: &mut Vec<(f64, [f64; 11])>) {
+        rows.clear();
+        rows.extend((1..=self.model.segments).map(|i| {
+            let c = VertexFrames::at(state, i);
+            let q = SVector::<f64, 8>::from(vertex_variables(state, i));
+            let (v, g8) =
+                num_dual::gradient(|v: SVector<_, 8>| normal_curvature(v.as_slice(), &c), &q);
+            (v, vertex_gradient_to_nodes(g8.as_slice()))
+        }));
     }
 
     /// Total energy.
@@ -442,13 +453,7 @@ impl RodEnergy {
             |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms, w),
             &q,
         );
-        let mut g = [0.0; 11];
-        for (a, ga) in g.iter_mut().enumerate() {
-            for &(k, alpha) in vertex_chain(a).iter().filter(|c| c.0 != usize::MAX) {
-                *ga += alpha * g8[k];
-            }
-        }
-        (e, g)
+        (e, vertex_gradient_to_nodes(g8.as_slice()))
     }
 
     fn edge_gradient(&self, state: &RodState, j: usize) -> (f64, [f64; 6]) {

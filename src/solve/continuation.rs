@@ -103,6 +103,8 @@ pub struct Tracer<'a> {
     dofs: usize,
     /// Constrained laws: the KKT system.
     kkt: Option<Kkt>,
+    /// Constraint rows of the last linearisation (allocation reused).
+    rows: Vec<(f64, [f64; 11])>,
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -131,6 +133,7 @@ impl<'a> Tracer<'a> {
             weight: 1.0 / n as f64,
             dofs: n,
             kkt,
+            rows: Vec::new(),
         }
     }
 
@@ -189,12 +192,13 @@ impl<'a> Tracer<'a> {
         let mut infeasibility = 0.0f64;
         if let Some(kkt) = &mut self.kkt {
             // residual (∇E + Jᵀ(λ + ρc), c) and its parameter derivative
-            let rows = energy.constraint_rows(state);
-            for (g, r) in self.grad[n..].iter_mut().zip(&rows) {
+            let rows = &mut self.rows;
+            energy.constraint_rows_into(state, rows);
+            for (g, r) in self.grad[n..].iter_mut().zip(rows.iter()) {
                 *g = r.0;
             }
-            energy.constraint_parameter_derivative(&rows, &velocity, &mut self.fp[n..]);
-            kkt.assemble(&self.values, &rows);
+            energy.constraint_parameter_derivative(rows, &velocity, &mut self.fp[n..]);
+            kkt.assemble(&self.values, rows);
             let h = energy.model.segment_length();
             infeasibility = rows.iter().map(|r| (r.0 / h).abs()).fold(0.0, f64::max);
         }

@@ -353,29 +353,18 @@ impl Newton {
             }
             // Armijo backtracking on the energy
             let slope: f64 = self.step.iter().zip(&self.grad).map(|(s, g)| s * g).sum();
-            let mut alpha = 1.0;
-            let mut accepted = false;
-            for _ in 0..40 {
-                for (t, v) in self.trial_step.iter_mut().zip(&self.step) {
+            let (energy, step, trial_step) = (&self.energy, &self.step, &mut self.trial_step);
+            let alpha = armijo(info.energy, slope, |alpha| {
+                for (t, v) in trial_step.iter_mut().zip(step) {
                     *t = alpha * v;
                 }
-                state.displace_into(&map, &self.trial_step, &mut trial);
-                let e = self.energy.energy(&trial);
-                // near convergence the energy decrease is below round-off: accept
-                // a full step whose energy is equal to working precision
-                let tol = 1e-14 * info.energy.abs().max(1.0);
-                if e.is_finite() && e <= info.energy + 1e-4 * alpha * slope + tol {
-                    accepted = true;
-                    break;
-                }
-                alpha *= 0.5;
-            }
-            if !accepted {
-                return Err(SolveError::LineSearch {
-                    iteration: it,
-                    residual: rel,
-                });
-            }
+                state.displace_into(&map, trial_step, &mut trial);
+                Some(energy.energy(&trial))
+            })
+            .ok_or(SolveError::LineSearch {
+                iteration: it,
+                residual: rel,
+            })?;
             // a full step keeps the pure Newton method; a cut step (a poor
             // quadratic model: near-singular H, far from equilibrium) damps
             // the next one
@@ -391,6 +380,26 @@ impl Newton {
         }
         Err(report.not_converged())
     }
+}
+
+/// Armijo backtracking from a merit value `merit0` with directional derivative
+/// `slope` along the step: `merit(alpha)` evaluates the trial (None rejects it
+/// outright, e.g. a step through a contact); returns the accepted α. Near
+/// convergence the decrease is below round-off: a trial equal to working
+/// precision is accepted.
+pub fn armijo(merit0: f64, slope: f64, mut merit: impl FnMut(f64) -> Option<f64>) -> Option<f64> {
+    let tol = 1e-14 * merit0.abs().max(1.0);
+    let mut alpha = 1.0;
+    for _ in 0..40 {
+        if let Some(e) = merit(alpha)
+            && e.is_finite()
+            && e <= merit0 + 1e-4 * alpha * slope.min(0.0) + tol
+        {
+            return Some(alpha);
+        }
+        alpha *= 0.5;
+    }
+    None
 }
 
 /// Relative gradient (against the scale of the internal forces) and whether

@@ -14,7 +14,7 @@
 use crate::geometry::contact::{Gap, Obstacle};
 use crate::model::rod::RodState;
 use crate::solve::kkt::Kkt;
-use crate::solve::newton::{Newton, NewtonReport, NewtonSettings, SolveError, residual};
+use crate::solve::newton::{Newton, NewtonReport, NewtonSettings, SolveError, armijo, residual};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettings, DefaultSolver, IPSolver, SolverStatus,
@@ -183,6 +183,13 @@ pub fn minimize(
     let mut values = vec![0.0; nnz];
     let mut jtc = vec![0.0; n];
     let mut jtl = vec![0.0; n];
+    // per-iteration work vectors, allocated once
+    let mut lagrangian = vec![0.0; n];
+    let mut q = vec![0.0; n];
+    let mut residual_kkt = vec![0.0; n + m_eq];
+    let mut trial_step = vec![0.0; n];
+    let mut part = vec![0.0; n];
+    let mut sub = state.clone();
     let mut jacobian = ConstraintMatrix::new(newton);
     let mut kkt = constrained.then(|| Kkt::new(&newton.energy));
     let p_pattern = &newton.energy.pattern.matrix;
@@ -211,7 +218,7 @@ pub fn minimize(
         jacobian.fill(&rows);
         let (gaps, gap_rows) = contact_rows(newton, state);
         // Lagrangian gradient ∇E + Jᵀλ − Σ z ∇g = ∇(augmented) − ρ Jᵀc − Σ z ∇g
-        let mut lagrangian = grad.clone();
+        lagrangian.copy_from_slice(&grad);
         if constrained {
             jacobian.transpose_mul(&c, &mut jtc);
             lagrangian
@@ -314,41 +321,15 @@ pub fn minimize(
             }
         }
         // QP: linear term ∇E + ρ Jᵀc = ∇(augmented) − Jᵀλ
-        let mut q = grad.clone();
+        q.copy_from_slice(&grad);
         if constrained {
             jacobian.transpose_mul(&state.multipliers[1..], &mut jtl);
             q.iter_mut().zip(&jtl).for_each(|(g, j)| *g -= j);
         }
         let (mut d, mut new_lambda, z) = if m_eq == 0 && gaps.is_empty() {
-            // nothing to constrain: the Newton step, or near a saddle (small
-            // gradient, indefinite H: a shifted step would creep) a step
-            // along the direction of negative curvature, downhill
+            // nothing to constrain here: the (shifted) Newton step
             let mut d: Vec<f64> = q.iter().map(|x| -x).collect();
             newton.ldlt.solve_in_place(&mut d);
-            if shift > 0.0 && rel < 1e-6 {
-                let mut h = values.clone();
-                for &s in &newton.energy.pattern.diagonal {
-                    h[s] -= shift;
-                }
-                if let Ok(sp) = crate::stability::lowest_eigenvalues(
-                    &newton.energy.pattern,
-                    &h,
-                    None,
-                    1,
-                    &mut newton.ldlt,
-                ) && let (Some(&lambda), Some(v)) = (sp.values.first(), sp.vectors.first())
-                {
-                    let largest = (0..n)
-                        .filter(|&k| map.is_translation(k))
-                        .map(|k| v[k].abs())
-                        .fold(0.0, f64::max);
-                    if lambda < 0.0 && largest > 0.0 {
-                        let uphill: f64 = v.iter().zip(&q).map(|(a, b)| a * b).sum();
-                        let scale = if uphill > 0.0 { -1e-3 } else { 1e-3 } / largest;
-                        d = v.iter().map(|x| scale * x).collect();
-                    }
-                }
-            }
             (d, Vec::new(), Vec::new())
         } else {
             let (a, b) = stack_rows(&jacobian.matrix, &c, &gap_rows, &gaps, n);
@@ -378,7 +359,7 @@ pub fn minimize(
             if kkt.ldlt.factor(&kkt.values).is_ok() {
                 report.factorizations += 1;
                 for _ in 0..2 {
-                    let mut r = vec![0.0; n + segments];
+                    let r = &mut residual_kkt;
                     newton.energy.pattern.mul_vec(&values, &d, &mut r[..n]);
                     jacobian.transpose_mul(&new_lambda, &mut jtl);
                     for k in 0..n {
@@ -388,7 +369,7 @@ pub fn minimize(
                     for (rc, ck) in r[n..].iter_mut().zip(&c) {
                         *rc = -(*rc + ck);
                     }
-                    kkt.ldlt.solve_in_place(&mut r);
+                    kkt.ldlt.solve_in_place(r);
                     d.iter_mut().zip(&r[..n]).for_each(|(x, y)| *x += y);
                     new_lambda
                         .iter_mut()
@@ -407,10 +388,9 @@ pub fn minimize(
         {
             // keep the polish only if it is at least as good a QP solution
             // (a wrong active set from an inexact interior point would not be)
-            let objective = |x: &[f64]| {
-                let mut px = vec![0.0; n];
-                newton.energy.pattern.mul_vec(&values, x, &mut px);
-                0.5 * x.iter().zip(&px).map(|(a, b)| a * b).sum::<f64>()
+            let mut objective = |x: &[f64]| {
+                newton.energy.pattern.mul_vec(&values, x, &mut part);
+                0.5 * x.iter().zip(&part).map(|(a, b)| a * b).sum::<f64>()
                     + x.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>()
             };
             if objective(&dp) <= objective(&d) + 1e-12 * objective(&d).abs() {
@@ -440,8 +420,14 @@ pub fn minimize(
         let mu = 2.0 * z.iter().fold(0.0f64, |a, b| a.max(*b)) + 1.0;
         let contact_penalty = |s: &RodState| -> f64 {
             match &newton.contact {
-                Some(m) => gaps.iter().map(|g| (-m.gap_at(s, g)).max(0.0)).sum::<f64>() * mu,
-                None => 0.0,
+                Some(m) if !gaps.is_empty() => {
+                    let (points, _) = s.centreline();
+                    gaps.iter()
+                        .map(|g| (-m.gap_at(&points, g)).max(0.0))
+                        .sum::<f64>()
+                        * mu
+                }
+                _ => 0.0,
             }
         };
         let merit_info = newton.energy.gradient(state, &mut grad);
@@ -456,10 +442,8 @@ pub fn minimize(
                 residual: rel,
             });
         }
-        let mut alpha = 1.0;
-        let mut accepted = false;
-        let mut trial_step = vec![0.0; n];
-        for _ in 0..40 {
+        let energy = &newton.energy;
+        armijo(merit0, slope, |alpha| {
             for (t, v) in trial_step.iter_mut().zip(&step) {
                 *t = alpha * v;
             }
@@ -472,36 +456,27 @@ pub fn minimize(
             {
                 let largest_move = alpha * largest.min(step_cap);
                 let pieces = ((4.0 * largest_move / m.diameter).ceil() as usize).clamp(1, 64);
-                let mut sub = state.clone();
-                let mut through = false;
                 for k in 1..=pieces {
                     let f = k as f64 / pieces as f64;
-                    let part: Vec<f64> = trial_step.iter().map(|x| f * x).collect();
+                    part.iter_mut()
+                        .zip(&trial_step)
+                        .for_each(|(p, x)| *p = f * x);
                     state.displace_into(&map, &part, &mut sub);
-                    if gaps.iter().any(|g| m.gap_at(&sub, g) < -0.5 * m.diameter) {
-                        through = true;
-                        break;
+                    let (points, _) = sub.centreline();
+                    if gaps
+                        .iter()
+                        .any(|g| m.gap_at(&points, g) < -0.5 * m.diameter)
+                    {
+                        return None;
                     }
                 }
-                if through {
-                    alpha *= 0.5;
-                    continue;
-                }
             }
-            let e = newton.energy.energy(&trial) + contact_penalty(&trial);
-            let tol = 1e-14 * merit0.abs().max(1.0);
-            if e.is_finite() && e <= merit0 + 1e-4 * alpha * slope.min(0.0) + tol {
-                accepted = true;
-                break;
-            }
-            alpha *= 0.5;
-        }
-        if !accepted {
-            return Err(SolveError::LineSearch {
-                iteration: it,
-                residual: rel,
-            });
-        }
+            Some(energy.energy(&trial) + contact_penalty(&trial))
+        })
+        .ok_or(SolveError::LineSearch {
+            iteration: it,
+            residual: rel,
+        })?;
         std::mem::swap(state, &mut trial);
     }
     Err(report.not_converged())
