@@ -119,6 +119,7 @@ fn bench(c: &mut Criterion) {
                 &report,
                 &measure,
                 Some(&previous),
+                Some(&b.hessian),
             )
             .unwrap();
         })

@@ -105,7 +105,15 @@ pub fn run(scenes: &Path) -> Result<Report> {
     if let Some(c) = main_branch.continuation.as_mut() {
         c.switch_branches = false;
     }
+    // stability at every point from the inertia of the corrector's LDLᵀ
+    // (issue 9: eigenvalues only when asked), then with the scene's request of
+    // the two lowest eigenvalues (and frequencies) at every point on top
+    let mut inertia_only = main_branch.clone();
+    inertia_only.stability.eigenvalues = 0;
     workloads.push(timed("figure_3_branch", 200, || {
+        crate::run::run_scene(&inertia_only, Some(200), &mut |_| Ok(())).map(|_| ())
+    })?);
+    workloads.push(timed("figure_3_branch_with_eigenvalues", 200, || {
         crate::run::run_scene(&main_branch, Some(200), &mut |_| Ok(())).map(|_| ())
     })?);
     let mut island = fig7.clone();

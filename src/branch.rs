@@ -146,6 +146,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             &report,
             &self.options.measure,
             self.previous.as_ref(),
+            Some(&p.hessian),
         )?;
         eq.branch = branch;
         eq.leg = leg;

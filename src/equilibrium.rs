@@ -388,32 +388,45 @@ pub fn analyse(
     report: &NewtonReport,
     measure: &Measure,
 ) -> Result<Equilibrium> {
-    analyse_from(newton, state, report, measure, None)
+    analyse_from(newton, state, report, measure, None, None)
 }
 
 /// As [`analyse`], for a state reached from the measured equilibrium
 /// `previous` (the writhe and knot type are carried over when no strand can
-/// have passed through another: see [`Shape::continued`]).
+/// have passed through another: see [`Shape::continued`]), and with the
+/// Hessian at `state` when the caller has it already.
 pub fn analyse_from(
     newton: &mut Newton,
     state: &RodState,
     report: &NewtonReport,
     measure: &Measure,
     previous: Option<&Equilibrium>,
+    hessian: Option<&[f64]>,
 ) -> Result<Equilibrium> {
     let k = measure.eigenvalues;
     let energy: &RodEnergy = &newton.energy;
-    let n = energy.map.len();
-    let mut grad = vec![0.0; n];
-    let mut values = vec![0.0; energy.pattern.nnz()];
-    energy.hessian(state, &mut grad, &mut values);
+    let mut values = match hessian {
+        Some(h) if h.len() == energy.pattern.nnz() => h.to_vec(),
+        _ => {
+            let mut grad = vec![0.0; energy.map.len()];
+            let mut values = vec![0.0; energy.pattern.nnz()];
+            energy.hessian(state, &mut grad, &mut values);
+            values
+        }
+    };
     hold_contacts(newton, state, report, &mut values);
     let energy: &RodEnergy = &newton.energy;
     let plain = lowest_eigenvalues(&energy.pattern, &values, None, k, &mut newton.ldlt)
         .context("stability of the Hessian")?;
-    let mass = energy.lumped_mass();
-    let pencil = lowest_eigenvalues(&energy.pattern, &values, Some(&mass), k, &mut newton.ldlt)
-        .context("stability with the lumped mass")?;
+    // with no eigenvalues asked the inertia is all, and the pencil adds nothing
+    let pencil_values = if k > 0 {
+        let mass = energy.lumped_mass();
+        lowest_eigenvalues(&energy.pattern, &values, Some(&mass), k, &mut newton.ldlt)
+            .context("stability with the lumped mass")?
+            .values
+    } else {
+        Vec::new()
+    };
     let reactions = newton.energy.clamp_reactions(state);
     let (min_z, max_z) = state.z_range();
     let z_star = state.clamps.z_star;
@@ -467,7 +480,7 @@ pub fn analyse_from(
         max_z,
         walled,
         lowest_eigenvalues: plain.values,
-        omega_squared: pencil.values,
+        omega_squared: pencil_values,
         negative_eigenvalues: plain.negative_count,
         stable,
         writhe: shape.writhe,

@@ -253,13 +253,14 @@ pub fn run_loading(
             };
             let context = || format!("loading leg {leg}, step {k}");
             let mut step = carry(newton, &state, c, settings).with_context(context)?;
-            let mut next = analyse_from(newton, &step.state, &step.report, measure, Some(&eq))?;
+            let mut next =
+                analyse_from(newton, &step.state, &step.report, measure, Some(&eq), None)?;
             if step.jumped || link_jump(&eq, &next).abs() > JUMP_LINK {
                 // a hand moves slowly: the rod jumps where its branch ends, not
                 // where a finite step happened to overshoot
                 let mut lo_eq = eq.clone();
                 let (lo_state, hi) = locate_on_path(newton, &state, c, settings, &mut |nw, t| {
-                    let t_eq = analyse_from(nw, &t.state, &t.report, measure, Some(&lo_eq))?;
+                    let t_eq = analyse_from(nw, &t.state, &t.report, measure, Some(&lo_eq), None)?;
                     let same = !t.jumped && link_jump(&lo_eq, &t_eq).abs() <= JUMP_LINK;
                     if same {
                         lo_eq = t_eq;
@@ -270,8 +271,14 @@ pub fn run_loading(
                 // the last step from the end of the branch jumps; the rod then
                 // moves on from where it landed to this step's clamps
                 let landed = carry(newton, &lo_state, hi, settings).with_context(context)?;
-                let landed_eq =
-                    analyse_from(newton, &landed.state, &landed.report, measure, Some(&lo_eq))?;
+                let landed_eq = analyse_from(
+                    newton,
+                    &landed.state,
+                    &landed.report,
+                    measure,
+                    Some(&lo_eq),
+                    None,
+                )?;
                 if landed.jumped || link_jump(&lo_eq, &landed_eq).abs() > JUMP_LINK {
                     events.push(path_event(
                         // the link changes by ±2 without a jump when the
@@ -286,8 +293,14 @@ pub fn run_loading(
                         ),
                     ));
                     step = carry(newton, &landed.state, c, settings).with_context(context)?;
-                    next =
-                        analyse_from(newton, &step.state, &step.report, measure, Some(&landed_eq))?;
+                    next = analyse_from(
+                        newton,
+                        &step.state,
+                        &step.report,
+                        measure,
+                        Some(&landed_eq),
+                        None,
+                    )?;
                 }
             }
             if eq.walled != next.walled && !step.jumped {

@@ -62,10 +62,10 @@ impl Summary {
             std::fs::create_dir_all(dir)?;
         }
         let tmp = path.with_extension("json.tmp");
-        let mut f = std::fs::File::create(&tmp)?;
+        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
         serde_json::to_writer_pretty(&mut f, self)?;
         f.write_all(b"\n")?;
-        f.sync_all()?;
+        f.into_inner()?.sync_all()?;
         std::fs::rename(&tmp, path)?;
         Ok(())
     }

@@ -10,9 +10,10 @@
 //! so these derivatives are those of the energy along the solver's own steps.
 
 use crate::model::frames::{self, Scalar, V3, lift};
+use crate::model::jet::{self, Jet3, Jet4, Jet8};
 use crate::model::rod::{DofMap, Law, RodModel, RodState, tangent};
 use crate::solve::sparse::{NO_SLOT, SymmetricPattern};
-use nalgebra::{SVector, Vector3};
+use nalgebra::Vector3;
 
 /// Which energy terms to include.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -118,78 +119,178 @@ fn vertex_gradient_to_nodes(g8: &[f64]) -> [f64; 11] {
 
 /// Map an 8-variable gradient and Hessian to the 11 node variables.
 fn vertex_to_nodes(g8: &[f64], h8: &[f64]) -> ([f64; 11], [f64; 121]) {
-    let mut g = [0.0; 11];
+    // e_{i-1} = x_i − x_{i−1}, e_i = x_{i+1} − x_i: node block k of the
+    // Hessian is Σ c_a c_b H8[edge a][edge b] over the edges at each node
+    let g = vertex_gradient_to_nodes(g8);
     let mut h = [0.0; 121];
-    for a in 0..11 {
-        for &(i, alpha) in vertex_chain(a).iter().filter(|c| c.0 != usize::MAX) {
-            g[a] += alpha * g8[i];
-            for b in 0..11 {
-                for &(j, beta) in vertex_chain(b).iter().filter(|c| c.0 != usize::MAX) {
-                    h[a * 11 + b] += alpha * beta * h8[i * 8 + j];
-                }
+    // edge-space 3×3 blocks (E0,E0), (E0,E1), (E1,E1) and the angle rows
+    let block = |p: usize, q: usize, r: usize, c: usize| h8[(3 * p + r) * 8 + 3 * q + c];
+    for r in 0..3 {
+        for c in 0..3 {
+            let (a, b, d) = (block(0, 0, r, c), block(0, 1, r, c), block(1, 1, r, c));
+            let b_t = block(1, 0, r, c);
+            // node blocks (x_{i-1}, x_i, x_{i+1}) with coefficients (−1, 0) (1, −1) (0, 1)
+            let at = |i: usize, j: usize| (i * 3 + r) * 11 + j * 3 + c;
+            h[at(0, 0)] = a;
+            h[at(0, 1)] = -a + b;
+            h[at(0, 2)] = -b;
+            h[at(1, 0)] = -a + b_t;
+            h[at(1, 1)] = a - b - b_t + d;
+            h[at(1, 2)] = b - d;
+            h[at(2, 0)] = -b_t;
+            h[at(2, 1)] = b_t - d;
+            h[at(2, 2)] = d;
+        }
+    }
+    for (t, row) in [(9, 6), (10, 7)] {
+        for (u, col) in [(9, 6), (10, 7)] {
+            h[t * 11 + u] = h8[row * 8 + col];
+        }
+        for c in 0..3 {
+            let (e0, e1) = (h8[row * 8 + c], h8[row * 8 + 3 + c]);
+            for (node, v) in [(0, -e0), (1, e0 - e1), (2, e1)] {
+                h[t * 11 + node * 3 + c] = v;
+                h[(node * 3 + c) * 11 + t] = v;
             }
         }
     }
     (g, h)
 }
 
-struct VertexGeometry<T> {
-    /// Integrated curvature binormal 2 t0 × t1 / (1 + t0·t1) ≈ h (u1 d1 + u2 d2).
-    kb: V3<T>,
-    t1: V3<T>,
-    a0: V3<T>,
-    a1: V3<T>,
-    t0: V3<T>,
+/// What one edge of a vertex stencil contributes: its tangent, reference
+/// director (time-parallel transported from the stored one) and material
+/// directors.
+#[derive(Clone, Copy)]
+struct EdgeFrame<T> {
+    t: V3<T>,
+    a: V3<T>,
+    d1: V3<T>,
+    d2: V3<T>,
+    theta: T,
 }
 
-fn vertex_geometry<T: Scalar>(q: &[T], c: &VertexFrames) -> VertexGeometry<T> {
-    let e0 = [q[0], q[1], q[2]];
-    let e1 = [q[3], q[4], q[5]];
-    let t0 = frames::scale(frames::norm(e0).recip(), e0);
-    let t1 = frames::scale(frames::norm(e1).recip(), e1);
-    let a0 = frames::parallel_transport(lift(&c.a_prev), lift(&c.t_prev), t0);
-    let a1 = frames::parallel_transport(lift(&c.a), lift(&c.t), t1);
-    let kb = frames::scale(
+/// Unit tangent of edge vector `e` and the reference director transported to
+/// it from the stored (a_ref, t_ref).
+fn tangent_and_reference<T: Scalar>(
+    e: V3<T>,
+    a_ref: &Vector3<f64>,
+    t_ref: &Vector3<f64>,
+) -> (V3<T>, V3<T>) {
+    let t = frames::scale(frames::norm(e).recip(), e);
+    (t, frames::parallel_transport(lift(a_ref), lift(t_ref), t))
+}
+
+impl<T: Scalar> EdgeFrame<T> {
+    fn of(e: V3<T>, theta: T, a_ref: &Vector3<f64>, t_ref: &Vector3<f64>) -> Self {
+        let (t, a) = tangent_and_reference(e, a_ref, t_ref);
+        let (d1, d2) = frames::material_directors(t, a, theta);
+        EdgeFrame {
+            t,
+            a,
+            d1,
+            d2,
+            theta,
+        }
+    }
+}
+
+/// The two edge frames of vertex i from its variables (e_{i-1}, e_i, θ_{i-1}, θ_i).
+fn edge_frames<T: Scalar>(q: &[T], c: &VertexFrames) -> [EdgeFrame<T>; 2] {
+    [
+        EdgeFrame::of([q[0], q[1], q[2]], q[6], &c.a_prev, &c.t_prev),
+        EdgeFrame::of([q[3], q[4], q[5]], q[7], &c.a, &c.t),
+    ]
+}
+
+/// Integrated curvature binormal 2 t0 × t1 / (1 + t0·t1).
+fn curvature_binormal<T: Scalar>(t0: V3<T>, t1: V3<T>) -> V3<T> {
+    frames::scale(
         (frames::dot(t0, t1) + 1.0).recip() * 2.0,
         frames::cross(t0, t1),
+    )
+}
+
+/// Reference twist between the edges (t0, a0) and (t1, a1), continued from
+/// its stored value `r` (the angle from a0 transported to t1 and turned by r,
+/// to a1, is small).
+fn reference_twist<T: Scalar>(t0: V3<T>, a0: V3<T>, t1: V3<T>, a1: V3<T>, r: f64) -> T {
+    let ut = frames::parallel_transport(a0, t0, t1);
+    let (s, c) = r.sin_cos();
+    let ut = frames::add(
+        frames::scale(T::from(c), ut),
+        frames::scale(T::from(s), frames::cross(t1, ut)),
     );
-    VertexGeometry { kb, t1, a0, a1, t0 }
+    frames::signed_angle(ut, a1, t1) + r
 }
 
-/// Bending energy at one vertex: (κ1² + K2 κ2²) / (2h), with κ the integrated
-/// curvature binormal projected on the averaged material directors.
-pub fn bending_energy<T: Scalar>(q: &[T], c: &VertexFrames, model: &RodModel) -> T {
-    let g = vertex_geometry(q, c);
-    bending_from(&g, q, model)
+/// Integrated strains of a vertex: κ1 = h u1, κ2 = h u2 (the curvature
+/// binormal on the averaged material directors) and the twist m = h u3.
+#[derive(Clone, Copy)]
+struct Strains<T> {
+    k1: T,
+    k2: T,
+    m: T,
 }
 
-fn bending_from<T: Scalar>(g: &VertexGeometry<T>, q: &[T], model: &RodModel) -> T {
-    let (d1a, d2a) = frames::material_directors(g.t0, g.a0, q[6]);
-    let (d1b, d2b) = frames::material_directors(g.t1, g.a1, q[7]);
-    let k1 = frames::dot(g.kb, frames::add(d1a, d1b)) * 0.5;
-    let k2 = frames::dot(g.kb, frames::add(d2a, d2b)) * 0.5;
-    (k1 * k1 + k2 * k2 * model.k2) * (0.5 / model.segment_length())
+fn strains<T: Scalar>(f: &[EdgeFrame<T>; 2], c: &VertexFrames) -> Strains<T> {
+    let kb = curvature_binormal(f[0].t, f[1].t);
+    let reference = reference_twist(f[0].t, f[0].a, f[1].t, f[1].a, c.reference_twist);
+    Strains {
+        k1: frames::dot(kb, frames::add(f[0].d1, f[1].d1)) * 0.5,
+        k2: frames::dot(kb, frames::add(f[0].d2, f[1].d2)) * 0.5,
+        m: f[1].theta - f[0].theta + reference,
+    }
 }
 
-/// Twist at one vertex: θ_i - θ_{i-1} + reference twist (continued from the
-/// stored value through time-parallel transport).
-pub fn vertex_twist<T: Scalar>(q: &[T], c: &VertexFrames) -> T {
-    let g = vertex_geometry(q, c);
-    twist_from(&g, q, c)
-}
-
-fn twist_from<T: Scalar>(g: &VertexGeometry<T>, q: &[T], c: &VertexFrames) -> T {
-    let r = T::from(c.reference_twist);
-    let ut = frames::parallel_transport(g.a0, g.t0, g.t1);
-    let ut = frames::rotate_about(ut, g.t1, r);
-    let reference = r + frames::signed_angle(ut, g.a1, g.t1);
-    q[7] - q[6] + reference
-}
-
-/// Twisting energy at one vertex: K3 m² / (2h).
-pub fn twisting_energy<T: Scalar>(q: &[T], c: &VertexFrames, model: &RodModel) -> T {
-    let m = vertex_twist(q, c);
-    m * m * (0.5 * model.k3 / model.segment_length())
+/// [`strains`] as jets in the 8 stencil variables, each intermediate
+/// differentiated only in the variables it depends on: tangents and reference
+/// directors in their edge's 3, material directors in 4 (edge and angle), the
+/// curvature binormal and reference twist in the 6 of both edges.
+fn strain_jets(q: [f64; 8], c: &VertexFrames) -> Strains<Jet8> {
+    const EDGE: [[usize; 3]; 2] = [[0, 1, 2], [3, 4, 5]];
+    const EDGE_AND_ANGLE: [[usize; 4]; 2] = [[0, 1, 2, 6], [3, 4, 5, 7]];
+    const BOTH: [usize; 6] = [0, 1, 2, 3, 4, 5];
+    // embeddings write in place: these jets are large and moving them costs
+    // more than the arithmetic
+    let zero8 = Jet8::from(0.0);
+    let zero6 = jet::Jet6::from(0.0);
+    let zero4 = Jet4::from(0.0);
+    let refs = [(&c.a_prev, &c.t_prev), (&c.a, &c.t)];
+    let (mut t6, mut a6) = ([[zero6; 3]; 2], [[zero6; 3]; 2]);
+    let (mut d1, mut d2) = ([zero8; 3], [zero8; 3]);
+    for k in 0..2 {
+        let e = [0, 1, 2].map(|j| Jet3::variable(q[EDGE[k][j]], j));
+        let (t, a) = tangent_and_reference(e, refs[k].0, refs[k].1);
+        let (mut t4, mut a4) = ([zero4; 3], [zero4; 3]);
+        for j in 0..3 {
+            t[j].embed_into(&mut t4[j], [0, 1, 2]);
+            a[j].embed_into(&mut a4[j], [0, 1, 2]);
+            t[j].embed_into(&mut t6[k][j], EDGE[k]);
+            a[j].embed_into(&mut a6[k][j], EDGE[k]);
+        }
+        let (e1, e2) = frames::material_directors(t4, a4, Jet4::variable(q[6 + k], 3));
+        for j in 0..3 {
+            let (mut x1, mut x2) = (zero8, zero8);
+            e1[j].embed_into(&mut x1, EDGE_AND_ANGLE[k]);
+            e2[j].embed_into(&mut x2, EDGE_AND_ANGLE[k]);
+            d1[j] += x1;
+            d2[j] += x2;
+        }
+    }
+    let kb6 = curvature_binormal(t6[0], t6[1]);
+    let mut kb = [zero8; 3];
+    for j in 0..3 {
+        kb6[j].embed_into(&mut kb[j], BOTH);
+    }
+    let mut m = Jet8::variable(q[7], 7) - Jet8::variable(q[6], 6);
+    let mut reference = zero8;
+    reference_twist(t6[0], a6[0], t6[1], a6[1], c.reference_twist).embed_into(&mut reference, BOTH);
+    m += reference;
+    Strains {
+        k1: frames::dot(kb, d1) * 0.5,
+        k2: frames::dot(kb, d2) * 0.5,
+        m,
+    }
 }
 
 /// Stretching energy of one edge (variables: the edge vector): S h/2 (|e|/h - 1)².
@@ -200,33 +301,18 @@ pub fn stretching_energy<T: Scalar>(q: &[T], model: &RodModel) -> T {
     strain * strain * (0.5 * model.stretching_stiffness * h)
 }
 
-/// Material curvatures at one vertex: integrated κ1 = h u1 and κ2 = h u2 (the
-/// curvature binormal on the averaged material directors).
-fn material_curvatures<T: Scalar>(g: &VertexGeometry<T>, q: &[T]) -> (T, T) {
-    let (d1a, d2a) = frames::material_directors(g.t0, g.a0, q[6]);
-    let (d1b, d2b) = frames::material_directors(g.t1, g.a1, q[7]);
-    (
-        frames::dot(g.kb, frames::add(d1a, d1b)) * 0.5,
-        frames::dot(g.kb, frames::add(d2a, d2b)) * 0.5,
-    )
-}
-
 /// Material curvatures and twist rate (u1, u2, u3) at vertex i.
 pub fn vertex_strains(state: &RodState, i: usize) -> [f64; 3] {
     let c = VertexFrames::at(state, i);
-    let q = vertex_variables(state, i);
-    let g = vertex_geometry(&q, &c);
-    let (k1, k2) = material_curvatures(&g, &q);
-    let m = twist_from(&g, &q, &c);
+    let u = strains(&edge_frames(&vertex_variables(state, i), &c), &c);
     let h = 1.0 / state.segments() as f64;
-    [k1 / h, k2 / h, m / h]
+    [u.k1 / h, u.k2 / h, u.m / h]
 }
 
 /// Integrated curvature κ2 = h u2 about d2 at one vertex: the strip's
 /// constraint function (u2 = 0).
 pub fn normal_curvature<T: Scalar>(q: &[T], c: &VertexFrames) -> T {
-    let g = vertex_geometry(q, c);
-    material_curvatures(&g, q).1
+    strains(&edge_frames(q, c), c).k2
 }
 
 /// Sadowsky energy of a strip at one vertex, h/2 (u1² + u3²)² / (u1² + ε²),
@@ -246,38 +332,57 @@ pub struct VertexMultiplier {
     pub penalty: f64,
 }
 
-fn vertex_energy<T: Scalar>(
+/// Bending and twisting energy (or the strip's, or the augmented
+/// Lagrangian's) at vertex i, from its variables.
+pub fn vertex_energy<T: Scalar>(
     q: &[T],
     c: &VertexFrames,
     model: &RodModel,
     terms: Terms,
     multiplier: Option<VertexMultiplier>,
 ) -> T {
-    let g = vertex_geometry(q, c);
+    energy_of_strains(strains(&edge_frames(q, c), c), model, terms, multiplier)
+}
+
+/// Energy, gradient and Hessian of [`vertex_energy`] (through [`strain_jets`]).
+fn vertex_energy_hessian(
+    q: [f64; 8],
+    c: &VertexFrames,
+    model: &RodModel,
+    terms: Terms,
+    multiplier: Option<VertexMultiplier>,
+) -> (f64, [f64; 8], [[f64; 8]; 8]) {
+    let e = energy_of_strains(strain_jets(q, c), model, terms, multiplier);
+    (e.v, e.g, e.dense_hessian())
+}
+
+fn energy_of_strains<T: Scalar>(
+    u: Strains<T>,
+    model: &RodModel,
+    terms: Terms,
+    multiplier: Option<VertexMultiplier>,
+) -> T {
     let h = model.segment_length();
-    let (k1, k2) = material_curvatures(&g, q);
     let mut e = T::from(0.0);
     match model.law {
         Law::Strip { regularisation } => {
             // bending and twisting do not separate in the strip law
             if terms.bending || terms.twisting {
-                let m = twist_from(&g, q, c);
-                e += strip_energy(k1, m, regularisation, h);
+                e += strip_energy(u.k1, u.m, regularisation, h);
             }
         }
         law => {
             if terms.bending {
                 let k2_stiffness = if law == Law::Kirchhoff { model.k2 } else { 0.0 };
-                e += (k1 * k1 + k2 * k2 * k2_stiffness) * (0.5 / h);
+                e += (u.k1 * u.k1 + u.k2 * u.k2 * k2_stiffness) * (0.5 / h);
             }
             if terms.twisting {
-                let m = twist_from(&g, q, c);
-                e += m * m * (0.5 * model.k3 / h);
+                e += u.m * u.m * (0.5 * model.k3 / h);
             }
         }
     }
     if let Some(w) = multiplier {
-        e += k2 * (k2 * (0.5 * w.penalty) + w.lambda);
+        e += u.k2 * (u.k2 * (0.5 * w.penalty) + w.lambda);
     }
     e
 }
@@ -376,10 +481,8 @@ impl RodEnergy {
         rows.clear();
         rows.extend((1..=self.model.segments).map(|i| {
             let c = VertexFrames::at(state, i);
-            let q = SVector::<f64, 8>::from(vertex_variables(state, i));
-            let (v, g8) =
-                num_dual::gradient(|v: SVector<_, 8>| normal_curvature(v.as_slice(), &c), &q);
-            (v, vertex_gradient_to_nodes(g8.as_slice()))
+            let (v, g8) = jet::gradient(vertex_variables(state, i), |v| normal_curvature(v, &c));
+            (v, vertex_gradient_to_nodes(&g8))
         }));
     }
 
@@ -412,30 +515,25 @@ impl RodEnergy {
     pub fn vertex_local(&self, state: &RodState, i: usize) -> (f64, [f64; 11], [f64; 121]) {
         let c = VertexFrames::at(state, i);
         let w = self.multiplier(state, i);
-        let q = SVector::<f64, 8>::from(vertex_variables(state, i));
-        let (e, g8, h8) = num_dual::hessian(
-            |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms, w),
-            &q,
-        );
-        let (g, h) = vertex_to_nodes(g8.as_slice(), h8.as_slice());
+        let (e, g8, h8) =
+            vertex_energy_hessian(vertex_variables(state, i), &c, &self.model, self.terms, w);
+        let (g, h) = vertex_to_nodes(&g8, h8.as_flattened());
         (e, g, h)
     }
 
     /// Energy, node-variable gradient and Hessian (row-major 6×6) of the
     /// stretching of edge j.
     pub fn edge_local(&self, state: &RodState, j: usize) -> (f64, [f64; 6], [f64; 36]) {
-        let q = SVector::<f64, 3>::from(edge_variables(state, j));
-        let (e, g3, h3) = num_dual::hessian(
-            |v: SVector<_, 3>| stretching_energy(v.as_slice(), &self.model),
-            &q,
-        );
+        let (e, g3, h3) = jet::hessian::<3, 6>(edge_variables(state, j), |v| {
+            stretching_energy(v, &self.model)
+        });
         let mut g = [0.0; 6];
         let mut h = [0.0; 36];
         for a in 0..3 {
             g[a] = -g3[a];
             g[3 + a] = g3[a];
             for b in 0..3 {
-                let v = h3[(a, b)];
+                let v = h3[a][b];
                 h[a * 6 + b] = v;
                 h[(3 + a) * 6 + 3 + b] = v;
                 h[a * 6 + 3 + b] = -v;
@@ -448,12 +546,10 @@ impl RodEnergy {
     fn vertex_gradient(&self, state: &RodState, i: usize) -> (f64, [f64; 11]) {
         let c = VertexFrames::at(state, i);
         let w = self.multiplier(state, i);
-        let q = SVector::<f64, 8>::from(vertex_variables(state, i));
-        let (e, g8) = num_dual::gradient(
-            |v: SVector<_, 8>| vertex_energy(v.as_slice(), &c, &self.model, self.terms, w),
-            &q,
-        );
-        (e, vertex_gradient_to_nodes(g8.as_slice()))
+        let (e, g8) = jet::gradient(vertex_variables(state, i), |v| {
+            vertex_energy(v, &c, &self.model, self.terms, w)
+        });
+        (e, vertex_gradient_to_nodes(&g8))
     }
 
     fn edge_gradient(&self, state: &RodState, j: usize) -> (f64, [f64; 6]) {

@@ -1,41 +1,43 @@
 //! Small 3-vector algebra generic over the scalar, so that the same stencil code
 //! runs on `f64` and on dual numbers (exact derivatives by forward-mode AD).
 
-use num_dual::DualNum;
-
-/// Scalar usable in the energy stencils: `f64` or a dual number over `f64`.
-pub trait Scalar: DualNum<Primitive = f64> + Copy {}
-impl<T: DualNum<Primitive = f64> + Copy> Scalar for T {}
+pub use crate::model::jet::Scalar;
 
 /// A 3-vector of scalars.
 pub type V3<T> = [T; 3];
 
 /// Lift a constant `f64` vector into the scalar type.
+#[inline]
 pub fn lift<T: Scalar>(v: &nalgebra::Vector3<f64>) -> V3<T> {
     [T::from(v[0]), T::from(v[1]), T::from(v[2])]
 }
 
 /// a + b
+#[inline]
 pub fn add<T: Scalar>(a: V3<T>, b: V3<T>) -> V3<T> {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 /// a - b
+#[inline]
 pub fn sub<T: Scalar>(a: V3<T>, b: V3<T>) -> V3<T> {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// s a
+#[inline]
 pub fn scale<T: Scalar>(s: T, a: V3<T>) -> V3<T> {
     [s * a[0], s * a[1], s * a[2]]
 }
 
 /// a · b
+#[inline]
 pub fn dot<T: Scalar>(a: V3<T>, b: V3<T>) -> T {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// a × b
+#[inline]
 pub fn cross<T: Scalar>(a: V3<T>, b: V3<T>) -> V3<T> {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -45,12 +47,14 @@ pub fn cross<T: Scalar>(a: V3<T>, b: V3<T>) -> V3<T> {
 }
 
 /// |a|
+#[inline]
 pub fn norm<T: Scalar>(a: V3<T>) -> T {
     dot(a, a).sqrt()
 }
 
 /// Parallel transport of `a` (perpendicular to the unit vector `t`) to the unit
 /// vector `t_new`: the rotation about t × t_new taking t to t_new, applied to a.
+#[inline]
 pub fn parallel_transport<T: Scalar>(a: V3<T>, t: V3<T>, t_new: V3<T>) -> V3<T> {
     let c = dot(t, t_new);
     let k = dot(a, t_new) / (c + 1.0);
@@ -58,18 +62,21 @@ pub fn parallel_transport<T: Scalar>(a: V3<T>, t: V3<T>, t_new: V3<T>) -> V3<T> 
 }
 
 /// Rotate `a` (perpendicular to the unit axis `t`) by `angle` about `t`.
+#[inline]
 pub fn rotate_about<T: Scalar>(a: V3<T>, t: V3<T>, angle: T) -> V3<T> {
     let (s, c) = angle.sin_cos();
     add(scale(c, a), scale(s, cross(t, a)))
 }
 
 /// Signed angle from `a` to `b` about the axis `t` (both perpendicular to t).
+#[inline]
 pub fn signed_angle<T: Scalar>(a: V3<T>, b: V3<T>, t: V3<T>) -> T {
     dot(cross(a, b), t).atan2(dot(a, b))
 }
 
 /// Material directors (d1, d2) of an edge with tangent `t`, reference director
 /// `a1` and material angle `theta`.
+#[inline]
 pub fn material_directors<T: Scalar>(t: V3<T>, a1: V3<T>, theta: T) -> (V3<T>, V3<T>) {
     let a2 = cross(t, a1);
     let (s, c) = theta.sin_cos();

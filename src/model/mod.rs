@@ -2,5 +2,6 @@
 
 pub mod energy;
 pub mod frames;
+pub mod jet;
 pub mod rod;
 pub mod shooting;

@@ -65,6 +65,9 @@ pub struct Point {
     /// (weighted norm): large when it had to jump to another part of the
     /// branch, e.g. across a hairpin.
     pub correction: f64,
+    /// The Hessian at the point (values on the energy's pattern), which the
+    /// corrector evaluated anyway: stability analysis reuses it.
+    pub hessian: std::sync::Arc<[f64]>,
 }
 
 /// Why a continuation step failed.
@@ -262,6 +265,7 @@ impl<'a> Tracer<'a> {
             iterations: 0,
             residual,
             correction: 0.0,
+            hessian: self.values.as_slice().into(),
         })
     }
 
@@ -307,6 +311,7 @@ impl<'a> Tracer<'a> {
                     correction: (self.weight * self.dot_q(&offset, &offset) + (p - p_pred).powi(2))
                         .sqrt()
                         / sigma.abs().max(1e-300),
+                    hessian: self.values.as_slice().into(),
                 });
             }
             if it == self.settings.max_corrector_iterations {
