@@ -111,6 +111,7 @@ fn bench(c: &mut Criterion) {
                 energy: 0.0,
                 factorizations: 0,
                 contacts: Vec::new(),
+                contact_rows: Vec::new(),
             };
             drop(tracer);
             knotrod::equilibrium::analyse_from(

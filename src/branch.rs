@@ -139,6 +139,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             energy,
             factorizations: 0,
             contacts: Vec::new(),
+            contact_rows: Vec::new(),
         };
         let mut eq = analyse_from(
             self.tracer.newton,

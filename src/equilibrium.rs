@@ -11,6 +11,7 @@ use crate::model::rod::{Clamps, Law, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
 use crate::scene::{InitialShape, Scene};
 use crate::solve::newton::{Newton, NewtonReport};
+use crate::solve::sqp::Widened;
 use crate::stability::lowest_eigenvalues;
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
@@ -328,19 +329,25 @@ impl Shape {
     }
 }
 
-/// Stability under contact: the Hessian restricted to motions that keep the
-/// active contacts (with a ray or a fixed obstacle) closed, by adding a stiff
-/// penalty ρ ∇g ∇gᵀ for each (like the constrained laws' augmented
-/// Lagrangian; its inertia is that of the restricted Hessian). Self-contacts
-/// couple distant dofs outside the sparse pattern and are not added: with
-/// them, the reported stability is that of the rod free to leave the contact
-/// in that direction only through its neighbours (conservative).
-fn hold_contacts(newton: &Newton, state: &RodState, report: &NewtonReport, values: &mut [f64]) {
-    let Some(model) = &newton.contact else {
-        return;
-    };
-    if report.contacts.is_empty() {
-        return;
+/// The Hessian with the contacts held: for each contact row carrying force z
+/// (gap closed), the Lagrangian's curvature −z ∇²g and a stiff penalty
+/// ρ ∇g∇gᵀ, so that the inertia and lowest eigenvalues are those on the
+/// tangent space of the active contacts (self-contacts included, on the
+/// pattern widened by their couplings). None without held contacts.
+fn hold_contacts(
+    newton: &Newton,
+    state: &RodState,
+    report: &NewtonReport,
+    values: &[f64],
+) -> Option<Widened> {
+    let model = newton.contact.as_ref()?;
+    let held: Vec<&(crate::geometry::contact::Gap, f64)> = report
+        .contact_rows
+        .iter()
+        .filter(|(g, z)| *z > 0.0 && g.gap < 1e-6 * model.diameter)
+        .collect();
+    if held.is_empty() {
+        return None;
     }
     let energy = &newton.energy;
     let max_diag = energy
@@ -349,36 +356,14 @@ fn hold_contacts(newton: &Newton, state: &RodState, report: &NewtonReport, value
         .iter()
         .map(|&s| values[s].abs())
         .fold(0.0, f64::max);
-    let rho = 1e3 * max_diag;
-    for g in model.gaps(state) {
-        if matches!(g.obstacle, crate::geometry::contact::Obstacle::SelfAt(_)) {
-            continue;
-        }
-        // a reported contact merges the rows of neighbouring segments
-        let reach = 1.5 * energy.model.segment_length() + 1e-9;
-        let held = g.gap < 1e-6 * model.diameter
-            && report.contacts.iter().any(|c| {
-                c.force > 0.0 && c.obstacle == g.obstacle.name() && (c.s - g.s).abs() <= reach
-            });
-        if !held {
-            continue;
-        }
-        let dofs: Vec<(usize, f64)> = g
-            .gradient
-            .iter()
-            .filter_map(|(k, v)| energy.map.node(*k).map(|d| (d, *v)))
-            .flat_map(|(d, v)| (0..3).map(move |c| (d + c, v[c])))
-            .collect();
-        for &(a, va) in &dofs {
-            for &(b, vb) in &dofs {
-                if a <= b
-                    && let Some(s) = energy.pattern.slot(a, b)
-                {
-                    values[s] += rho * va * vb;
-                }
-            }
-        }
-    }
+    Some(Widened::new(
+        energy,
+        values,
+        model,
+        state,
+        held.iter().map(|(g, z)| (g, *z)),
+        1e3 * max_diag,
+    ))
 }
 
 /// Measure an equilibrium found by `newton` (its energy is reused for the Hessian).
@@ -405,7 +390,7 @@ pub fn analyse_from(
 ) -> Result<Equilibrium> {
     let k = measure.eigenvalues;
     let energy: &RodEnergy = &newton.energy;
-    let mut values = match hessian {
+    let values = match hessian {
         Some(h) if h.len() == energy.pattern.nnz() => h.to_vec(),
         _ => {
             let mut grad = vec![0.0; energy.map.len()];
@@ -414,14 +399,18 @@ pub fn analyse_from(
             values
         }
     };
-    hold_contacts(newton, state, report, &mut values);
+    let mut held = hold_contacts(newton, state, report, &values);
     let energy: &RodEnergy = &newton.energy;
-    let plain = lowest_eigenvalues(&energy.pattern, &values, None, k, &mut newton.ldlt)
-        .context("stability of the Hessian")?;
+    let (pattern, values, ldlt) = match held.as_mut() {
+        Some(w) => (&w.pattern, &w.values, &mut w.ldlt),
+        None => (&energy.pattern, &values, &mut newton.ldlt),
+    };
+    let plain =
+        lowest_eigenvalues(pattern, values, None, k, ldlt).context("stability of the Hessian")?;
     // with no eigenvalues asked the inertia is all, and the pencil adds nothing
     let pencil_values = if k > 0 {
         let mass = energy.lumped_mass();
-        lowest_eigenvalues(&energy.pattern, &values, Some(&mass), k, &mut newton.ldlt)
+        lowest_eigenvalues(pattern, values, Some(&mass), k, ldlt)
             .context("stability with the lumped mass")?
             .values
     } else {

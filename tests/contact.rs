@@ -130,3 +130,143 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     assert_eq!(down.len(), 1, "{events:?}");
     assert!((down[0].phi_over_2pi - 0.751).abs() < 0.005);
 }
+
+#[test]
+fn twisted_loop_closes_on_itself_without_passing_through() {
+    // a buckled rod (z* = 0.4) twisted at one clamp: past about 1.4 turns the
+    // loop it forms wraps onto itself (self-contact). As the twist grows to
+    // 2.5 turns the strands press harder but never interpenetrate, and every
+    // state is a stable equilibrium with the contact held
+    let h = 0.005;
+    let scene = Scene::parse(&format!(
+        "[model]\nK2 = 1.5\nK3 = 0.7\nsegments = 60\nrod_diameter = {h}\n\
+         [clamps]\nz_star = 0.4\ndelta = 0.02\nphi_over_2pi = 0.0\n\
+         [initial]\nshape = \"straight\"\nbump = [0.0, 0.15, 0.0]\n\
+         [contact]\nrays = false\nself_contact = true\n\
+         [[loading]]\nphi_over_2pi = 2.5\nsteps = 50\n\
+         [stability]\neigenvalues = 1\n"
+    ))
+    .unwrap();
+    let mut eqs: Vec<Equilibrium> = Vec::new();
+    run_scene(&scene, None, &mut |e| {
+        eqs.push(e);
+        Ok(())
+    })
+    .unwrap();
+    assert!((eqs.last().unwrap().phi_over_2pi - 2.5).abs() < 1e-9);
+    let mut first_contact = None;
+    let mut last_force = 0.0;
+    for e in &eqs {
+        assert!(e.converged);
+        assert!(e.stable, "unstable at φ/2π = {}", e.phi_over_2pi);
+        assert!(
+            e.min_self_distance > h * (1.0 - 1e-6),
+            "self-distance {} at φ/2π = {}",
+            e.min_self_distance,
+            e.phi_over_2pi
+        );
+        let force: f64 = e.contacts.iter().map(|c| c.force).sum();
+        assert!(
+            e.contacts
+                .iter()
+                .all(|c| c.obstacle == "self" && c.force > 0.0 && c.gap > -1e-6 * h)
+        );
+        if first_contact.is_none() && !e.contacts.is_empty() {
+            first_contact = Some(e.phi_over_2pi);
+        }
+        if first_contact.is_some() {
+            // in contact from then on, pressing harder as the twist grows
+            assert!(
+                !e.contacts.is_empty(),
+                "contact lost at φ/2π = {}",
+                e.phi_over_2pi
+            );
+            assert!(
+                force > last_force,
+                "force {force} after {last_force} at φ/2π = {}",
+                e.phi_over_2pi
+            );
+            assert!((e.min_self_distance - h).abs() < 1e-6 * h);
+            last_force = force;
+        }
+    }
+    let first = first_contact.expect("the loop never closed");
+    assert!(
+        (1.3..1.6).contains(&first),
+        "first contact at φ/2π = {first}"
+    );
+    assert!(
+        last_force
+            > 5.0
+                * eqs
+                    .iter()
+                    .find(|e| !e.contacts.is_empty())
+                    .unwrap()
+                    .contacts[0]
+                    .force
+    );
+}
+
+#[test]
+fn gap_hessian_matches_finite_differences() {
+    use knotrod::geometry::contact::gap_hessian;
+    use nalgebra::Vector3;
+    // interior closest points, a closest point at an end, and both at ends
+    let cases = [
+        [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(1.0, 0.1, 0.0),
+            Vector3::new(0.4, -0.5, 0.3),
+            Vector3::new(0.6, 0.5, 0.35),
+        ],
+        [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(1.3, -0.5, 0.2),
+            Vector3::new(1.4, 0.5, 0.25),
+        ],
+        [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(1.3, 0.2, 0.2),
+            Vector3::new(1.8, 0.5, 0.25),
+        ],
+    ];
+    let distance = |p: &[Vector3<f64>; 4]| {
+        knotrod::geometry::distance::segment_distance(&p[0], &p[1], &p[2], &p[3]).0
+    };
+    let gradient = |p: &[Vector3<f64>; 4]| {
+        let step = 1e-6;
+        let mut g = [0.0; 12];
+        for (k, gk) in g.iter_mut().enumerate() {
+            let (mut a, mut b) = (*p, *p);
+            a[k / 3][k % 3] += step;
+            b[k / 3][k % 3] -= step;
+            *gk = (distance(&a) - distance(&b)) / (2.0 * step);
+        }
+        g
+    };
+    for p in &cases {
+        let h = gap_hessian(p);
+        let step = 1e-4;
+        for k in 0..12 {
+            let (mut a, mut b) = (*p, *p);
+            a[k / 3][k % 3] += step;
+            b[k / 3][k % 3] -= step;
+            let (ga, gb) = (gradient(&a), gradient(&b));
+            for j in 0..12 {
+                let fd = (ga[j] - gb[j]) / (2.0 * step);
+                assert!(
+                    (fd - h[k][j]).abs() < 1e-5 * (1.0 + fd.abs()),
+                    "H[{k}][{j}] = {} vs {fd}",
+                    h[k][j]
+                );
+            }
+        }
+        // a rigid translation changes nothing
+        for (k, hk) in h.iter().enumerate() {
+            let row: f64 = (0..4).map(|n| hk[3 * n]).sum();
+            assert!(row.abs() < 1e-9, "translation row {k}: {row}");
+        }
+    }
+}

@@ -5,6 +5,7 @@
 //! a unique closest pair).
 
 use crate::geometry::distance::{CurveTree, segment_distance};
+use crate::model::jet::{self, Scalar};
 use crate::model::rod::RodState;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -99,6 +100,55 @@ fn pair_gap(p: &[Vector3<f64>; 4], diameter: f64) -> (f64, f64, f64, [Vector3<f6
     )
 }
 
+/// Distance between the segments x[0..3]–x[3..6] and x[6..9]–x[9..12] with the
+/// closest-point case of the current configuration held: each parameter is
+/// either interior (then it is the stationary point, a function of the
+/// coordinates) or at the end `Some(t)` where it sits. Smooth within the case,
+/// so its jets give the gap's exact second derivatives there.
+fn case_distance<T: Scalar>(x: &[T; 12], ta: Option<f64>, tb: Option<f64>) -> T {
+    let p = |k: usize| [x[3 * k], x[3 * k + 1], x[3 * k + 2]];
+    let sub = |a: [T; 3], b: [T; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let dot = |a: [T; 3], b: [T; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let along = |a: [T; 3], t: T, u: [T; 3]| [a[0] + t * u[0], a[1] + t * u[1], a[2] + t * u[2]];
+    let (u, v, w) = (sub(p(1), p(0)), sub(p(3), p(2)), sub(p(0), p(2)));
+    let (s, t) = match (ta, tb) {
+        (None, None) => {
+            let (a, b, c, d, e) = (dot(u, u), dot(u, v), dot(v, v), dot(u, w), dot(v, w));
+            let det = a * c - b * b;
+            ((b * e - c * d) / det, (a * e - b * d) / det)
+        }
+        (Some(s), None) => {
+            let s = T::from(s);
+            (s, dot(sub(along(p(0), s, u), p(2)), v) / dot(v, v))
+        }
+        (None, Some(t)) => {
+            let t = T::from(t);
+            (dot(sub(along(p(2), t, v), p(0)), u) / dot(u, u), t)
+        }
+        (Some(s), Some(t)) => (T::from(s), T::from(t)),
+    };
+    let r = sub(along(p(0), s, u), along(p(2), t, v));
+    dot(r, r).sqrt()
+}
+
+/// Second derivatives of the gap of segments p[0]p[1] and p[2]p[3] in their
+/// 12 coordinates (row-major), at the current closest-point case.
+pub fn gap_hessian(p: &[Vector3<f64>; 4]) -> [[f64; 12]; 12] {
+    let (_, ta, tb) = segment_distance(&p[0], &p[1], &p[2], &p[3]);
+    let (u, v) = (p[1] - p[0], p[3] - p[2]);
+    // nearly parallel segments: the interior stationary point is ill-posed,
+    // hold the first parameter where it is
+    let parallel = u.cross(&v).norm_squared() < 1e-10 * u.norm_squared() * v.norm_squared();
+    let end = |t: f64| (t <= 1e-12 || t >= 1.0 - 1e-12).then_some(t);
+    let ta_case = end(ta).or(parallel.then_some(ta));
+    let tb_case = end(tb);
+    let mut x = [0.0; 12];
+    for k in 0..4 {
+        x[3 * k..3 * k + 3].copy_from_slice(p[k].as_slice());
+    }
+    jet::hessian::<12, 78>(x, |y| case_distance(y, ta_case, tb_case)).2
+}
+
 impl ContactModel {
     /// Candidate contacts of `state` (gap below `margin`).
     pub fn gaps(&self, state: &RodState) -> Vec<Gap> {
@@ -187,6 +237,22 @@ impl ContactModel {
 
     /// The gap of a candidate (same segments and obstacle) for the centreline
     /// `points` of another state.
+    /// The four end points of a contact's segment pair (the rod's segment
+    /// first; a ray or obstacle contributes fixed points).
+    pub fn pair_points(&self, points: &[Vector3<f64>], c: &Gap) -> [Vector3<f64>; 4] {
+        let k = c.segments[0];
+        let other = match c.obstacle {
+            Obstacle::RayBottom => [Vector3::zeros(), -self.ray_length * Vector3::z()],
+            Obstacle::RayTop => {
+                let end = *points.last().unwrap();
+                [end, end + self.ray_length * Vector3::z()]
+            }
+            Obstacle::Fixed(o) => self.obstacles[o],
+            Obstacle::SelfAt(_) => [points[c.segments[1]], points[c.segments[1] + 1]],
+        };
+        [points[k], points[k + 1], other[0], other[1]]
+    }
+
     pub fn gap_at(&self, points: &[Vector3<f64>], c: &Gap) -> f64 {
         let k = c.segments[0];
         let other = match c.obstacle {

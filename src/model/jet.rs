@@ -6,6 +6,10 @@
 //! value type with the Hessian stored once (its lower triangle) and every
 //! operation inlined costs a fraction of a general hyper-dual number.
 
+// index loops mirror the formulas (packed triangle k ↔ (i, j)); division is
+// multiplication by the reciprocal's jet
+#![allow(clippy::needless_range_loop, clippy::suspicious_arithmetic_impl)]
+
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
 /// Scalar usable in the energy stencils: `f64`, [`Jet`] or [`Grad`].

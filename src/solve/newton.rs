@@ -47,6 +47,9 @@ pub struct NewtonReport {
     /// Contact forces at the solution (with a contact model).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub contacts: Vec<crate::solve::sqp::ContactForce>,
+    /// The contact rows behind them, with their forces (for stability).
+    #[serde(skip)]
+    pub contact_rows: Vec<(crate::geometry::contact::Gap, f64)>,
 }
 
 impl NewtonReport {
@@ -59,6 +62,7 @@ impl NewtonReport {
             energy: f64::NAN,
             factorizations: 0,
             contacts: Vec::new(),
+            contact_rows: Vec::new(),
         }
     }
 

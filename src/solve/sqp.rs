@@ -11,10 +11,12 @@
 //! Lagrangian with the new λ (no Maratos effect: full steps near the solution,
 //! quadratic convergence).
 
-use crate::geometry::contact::{Gap, Obstacle};
+use crate::geometry::contact::{ContactModel, Gap, Obstacle, gap_hessian};
+use crate::model::energy::RodEnergy;
 use crate::model::rod::RodState;
 use crate::solve::kkt::Kkt;
 use crate::solve::newton::{Newton, NewtonReport, NewtonSettings, SolveError, armijo, residual};
+use crate::solve::sparse::{Ldlt, SymmetricPattern};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettings, DefaultSolver, IPSolver, SolverStatus,
@@ -119,6 +121,98 @@ fn qp_settings() -> DefaultSettings<f64> {
     }
 }
 
+/// A Hessian on the energy's pattern widened by contact couplings (a
+/// self-contact couples distant nodes), with the contacts' terms added: the
+/// Lagrangian's curvature −z ∇²g of each contact with force z, and a penalty
+/// ρ ∇g ∇gᵀ (ρ > 0 holds the contacts in a stability analysis).
+pub struct Widened {
+    /// The widened pattern.
+    pub pattern: SymmetricPattern,
+    /// Values on it.
+    pub values: Vec<f64>,
+    /// Its factorisation workspace.
+    pub ldlt: Ldlt,
+}
+
+impl Widened {
+    /// Widen the energy Hessian `values` by the contacts `(gap, force)`.
+    pub fn new<'g>(
+        energy: &RodEnergy,
+        values: &[f64],
+        model: &ContactModel,
+        state: &RodState,
+        contacts: impl Iterator<Item = (&'g Gap, f64)> + Clone,
+        rho: f64,
+    ) -> Self {
+        let map = energy.map;
+        let n = energy.model.segments;
+        let nodes = |g: &Gap| -> Vec<usize> {
+            let [i, j] = g.segments;
+            if matches!(g.obstacle, Obstacle::SelfAt(_)) {
+                vec![i, i + 1, j, j + 1]
+            } else {
+                vec![i, i + 1]
+            }
+        };
+        let dofs = |k: usize| -> [Option<usize>; 3] {
+            match map.node(k) {
+                Some(d) => [Some(d), Some(d + 1), Some(d + 2)],
+                None => [None; 3],
+            }
+        };
+        let mut stencils: Vec<Vec<Option<usize>>> = (1..=n)
+            .map(|i| map.vertex_stencil(i).to_vec())
+            .chain((1..n).map(|j| map.edge_stencil(j).to_vec()))
+            .collect();
+        for (g, _) in contacts.clone() {
+            stencils.push(nodes(g).into_iter().flat_map(dofs).collect());
+        }
+        let pattern = SymmetricPattern::from_stencils(map.len(), &stencils);
+        let mut wide = vec![0.0; pattern.nnz()];
+        let old = &energy.pattern.matrix;
+        for c in 0..old.ncols() {
+            let range = old.col_offsets()[c]..old.col_offsets()[c + 1];
+            for (&r, v) in old.row_indices()[range.clone()].iter().zip(&values[range]) {
+                wide[pattern.slot(r, c).expect("widened pattern holds the old")] += v;
+            }
+        }
+        let (points, _) = state.centreline();
+        for (g, z) in contacts {
+            let local: Vec<Option<usize>> = nodes(g).into_iter().flat_map(dofs).collect();
+            let curvature = (z > 0.0).then(|| gap_hessian(&model.pair_points(&points, g)));
+            let gradient: Vec<f64> = g
+                .gradient
+                .iter()
+                .flat_map(|(_, v)| [v.x, v.y, v.z])
+                .collect();
+            for (a, da) in local.iter().enumerate() {
+                for (b, db) in local.iter().enumerate() {
+                    let (Some(da), Some(db)) = (da, db) else {
+                        continue;
+                    };
+                    if da > db {
+                        continue;
+                    }
+                    let mut v = 0.0;
+                    if let Some(h) = &curvature {
+                        v -= z * h[a][b];
+                    }
+                    if rho > 0.0 {
+                        v += rho * gradient[a] * gradient[b];
+                    }
+                    wide[pattern.slot(*da, *db).expect("contact stencil in pattern")] += v;
+                }
+            }
+        }
+        let ldlt = Ldlt::new(&pattern);
+        Widened {
+            pattern,
+            values: wide,
+            ldlt,
+        }
+    }
+}
+
 /// A contact force of an equilibrium.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactForce {
@@ -192,11 +286,6 @@ pub fn minimize(
     let mut sub = state.clone();
     let mut jacobian = ConstraintMatrix::new(newton);
     let mut kkt = constrained.then(|| Kkt::new(&newton.energy));
-    let p_pattern = &newton.energy.pattern.matrix;
-    let (p_colptr, p_rowval) = (
-        p_pattern.col_offsets().to_vec(),
-        p_pattern.row_indices().to_vec(),
-    );
     let step_cap = match &newton.contact {
         Some(c) => settings.max_step.min(0.5 * c.margin),
         None => settings.max_step,
@@ -279,36 +368,59 @@ pub fn minimize(
                 })
                 .collect();
             report.contacts = merge_contacts(rows, 1.5 * h);
+            report.contact_rows = forces
+                .iter()
+                .filter(|(_, z)| *z > 0.0)
+                .filter_map(|(g, z)| Some((gaps.iter().find(|x| same_pair(x, g))?.clone(), *z)))
+                .collect();
             return Ok(report);
         }
         if it == settings.max_iterations {
             break;
         }
+        // with contacts the QP's Hessian is that of the Lagrangian E − Σ z g
+        // (the contacts' curvature, forces from the last QP), on the energy's
+        // pattern widened by the contact couplings
+        let mut wide = match &newton.contact {
+            Some(model) if !gaps.is_empty() => Some(Widened::new(
+                &newton.energy,
+                &values,
+                model,
+                state,
+                gaps.iter().map(|g| {
+                    let z = forces
+                        .iter()
+                        .find(|f| same_pair(&f.0, g))
+                        .map_or(0.0, |f| f.1);
+                    (g, z)
+                }),
+                0.0,
+            )),
+            _ => None,
+        };
+        let (pat, vals, ldlt): (&SymmetricPattern, &mut Vec<f64>, &mut Ldlt) = match wide.as_mut() {
+            Some(w) => (&w.pattern, &mut w.values, &mut w.ldlt),
+            None => (&newton.energy.pattern, &mut values, &mut newton.ldlt),
+        };
         // convexify: W + shift I positive definite, the shift just beyond the
         // lowest eigenvalue (a larger one would make a falling rod creep)
         shift = 0.0;
         loop {
-            for &s in &newton.energy.pattern.diagonal {
-                values[s] += shift;
+            for &s in &pat.diagonal {
+                vals[s] += shift;
             }
             report.factorizations += 1;
-            if newton.ldlt.factor(&values).is_ok() && newton.ldlt.negative_count() == 0 {
+            if ldlt.factor(vals).is_ok() && ldlt.negative_count() == 0 {
                 break;
             }
-            for &s in &newton.energy.pattern.diagonal {
-                values[s] -= shift;
+            for &s in &pat.diagonal {
+                vals[s] -= shift;
             }
             shift = if shift == 0.0 {
-                let lowest = crate::stability::lowest_eigenvalues(
-                    &newton.energy.pattern,
-                    &values,
-                    None,
-                    1,
-                    &mut newton.ldlt,
-                )
-                .ok()
-                .and_then(|sp| sp.values.first().copied())
-                .unwrap_or(-1e-8 * max_diag);
+                let lowest = crate::stability::lowest_eigenvalues(pat, vals, None, 1, ldlt)
+                    .ok()
+                    .and_then(|sp| sp.values.first().copied())
+                    .unwrap_or(-1e-8 * max_diag);
                 1.5 * lowest.abs() + 1e-8 * max_diag
             } else {
                 2.0 * shift
@@ -329,7 +441,7 @@ pub fn minimize(
         let (mut d, mut new_lambda, z) = if m_eq == 0 && gaps.is_empty() {
             // nothing to constrain here: the (shifted) Newton step
             let mut d: Vec<f64> = q.iter().map(|x| -x).collect();
-            newton.ldlt.solve_in_place(&mut d);
+            ldlt.solve_in_place(&mut d);
             (d, Vec::new(), Vec::new())
         } else {
             let (a, b) = stack_rows(&jacobian.matrix, &c, &gap_rows, &gaps, n);
@@ -339,7 +451,7 @@ pub fn minimize(
             }
             let (d, duals) = solve_qp(
                 &mut solver,
-                (&p_colptr, &p_rowval, &values),
+                (pat.matrix.col_offsets(), pat.matrix.row_indices(), vals),
                 &q,
                 &a,
                 &b,
@@ -355,12 +467,12 @@ pub fn minimize(
         // polish (equality rows only): Newton on the QP's KKT conditions with
         // the exact sparse KKT factorisation
         if let Some(kkt) = kkt.as_mut().filter(|_| gaps.is_empty()) {
-            kkt.assemble(&values, &rows);
+            kkt.assemble(vals, &rows);
             if kkt.ldlt.factor(&kkt.values).is_ok() {
                 report.factorizations += 1;
                 for _ in 0..2 {
                     let r = &mut residual_kkt;
-                    newton.energy.pattern.mul_vec(&values, &d, &mut r[..n]);
+                    pat.mul_vec(vals, &d, &mut r[..n]);
                     jacobian.transpose_mul(&new_lambda, &mut jtl);
                     for k in 0..n {
                         r[k] = -(r[k] + q[k] + jtl[k]);
@@ -378,24 +490,45 @@ pub fn minimize(
                 }
             }
         }
-        // polish (contacts, no equality rows): the active contacts as
-        // equalities, their forces from the small Schur complement G P⁻¹ Gᵀ
-        // (one sparse solve per active contact)
+        // polish (contacts, no equality rows): the exact QP solution by an
+        // active-set iteration from the interior point's duals
         let mut z = z;
         if m_eq == 0
             && !gaps.is_empty()
-            && let Some((dp, zp)) = polish_contacts(newton, &q, &gap_rows, &gaps, &z)
+            && let Some((dp, zp)) = polish_contacts(ldlt, &q, &gap_rows, &gaps, &z, None)
         {
-            // keep the polish only if it is at least as good a QP solution
-            // (a wrong active set from an inexact interior point would not be)
+            // keep the polish unless the interior point's step is feasible
+            // and better (an inexact interior point can miss the active set,
+            // or stop outside the linearised constraints)
             let mut objective = |x: &[f64]| {
-                newton.energy.pattern.mul_vec(&values, x, &mut part);
+                pat.mul_vec(vals, x, &mut part);
                 0.5 * x.iter().zip(&part).map(|(a, b)| a * b).sum::<f64>()
                     + x.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>()
             };
-            if objective(&dp) <= objective(&d) + 1e-12 * objective(&d).abs() {
+            let feasible = gaps
+                .iter()
+                .zip(&gap_rows)
+                .all(|(g, r)| g.gap + r.iter().map(|&(k, v)| v * d[k]).sum::<f64>() >= -1e-9 * h);
+            if !feasible || objective(&dp) <= objective(&d) + 1e-12 * objective(&d).abs() {
                 d = dp;
                 z = zp;
+            }
+        }
+        // the convexified QP converges only linearly; where the true Hessian
+        // is positive definite on the active contacts' tangent space, the
+        // exact SQP step (same active set, unshifted Hessian) restores
+        // Newton's quadratic convergence
+        if m_eq == 0 && shift > 0.0 && z.iter().any(|v| *v > 0.0) {
+            report.factorizations += 1;
+            for &s in &pat.diagonal {
+                vals[s] -= shift;
+            }
+            if ldlt.factor(vals).is_ok() {
+                let k = ldlt.negative_count();
+                if let Some((dp, zp)) = polish_contacts(ldlt, &q, &gap_rows, &gaps, &z, Some(k)) {
+                    d = dp;
+                    z = zp;
+                }
             }
         }
         forces = gaps
@@ -432,8 +565,8 @@ pub fn minimize(
         };
         let merit_info = newton.energy.gradient(state, &mut grad);
         let merit0 = merit_info.energy + contact_penalty(state);
-        let slope: f64 = step.iter().zip(&grad).map(|(s, g)| s * g).sum::<f64>()
-            - mu * gaps.iter().map(|g| (-g.gap).max(0.0)).sum::<f64>();
+        let violation = mu * gaps.iter().map(|g| (-g.gap).max(0.0)).sum::<f64>();
+        let slope: f64 = step.iter().zip(&grad).map(|(s, g)| s * g).sum::<f64>() - violation;
         if slope >= 0.0 && rel > 1e3 * settings.gradient_tol {
             // not a descent direction (an inexact QP solution with a wrong
             // active set): say so now rather than creep
@@ -443,7 +576,7 @@ pub fn minimize(
             });
         }
         let energy = &newton.energy;
-        armijo(merit0, slope, |alpha| {
+        let mut merit_at = |alpha: f64| {
             for (t, v) in trial_step.iter_mut().zip(&step) {
                 *t = alpha * v;
             }
@@ -472,77 +605,128 @@ pub fn minimize(
                 }
             }
             Some(energy.energy(&trial) + contact_penalty(&trial))
-        })
-        .ok_or(SolveError::LineSearch {
+        };
+        let alpha = armijo(merit0, slope, &mut merit_at).ok_or(SolveError::LineSearch {
             iteration: it,
             residual: rel,
         })?;
+        // on a convexified (shifted) step near a saddle the full step can be
+        // far too short: the shift set by the unconstrained Hessian's lowest
+        // eigenvalue damps a direction that is only slightly unstable on the
+        // contacts' tangent space, and the rod would creep away. Extend the
+        // step while the merit keeps falling (up to the step cap)
+        if alpha == 1.0 && shift > 0.0 && m_eq == 0 {
+            let room = step_cap / largest.min(step_cap).max(1e-300);
+            let mut best = (1.0, merit_at(1.0).unwrap_or(f64::INFINITY));
+            let mut a = 2.0;
+            while a <= room.min(1024.0) {
+                match merit_at(a) {
+                    Some(m) if m < best.1 => best = (a, m),
+                    _ => break,
+                }
+                a *= 2.0;
+            }
+            merit_at(best.0);
+        }
         std::mem::swap(state, &mut trial);
     }
     Err(report.not_converged())
 }
 
-/// Newton on the QP's KKT conditions with the active contacts as equalities
-/// (P factored in `newton.ldlt`): returns the step and the contact forces, or
-/// None if the active set is empty or a force comes out negative twice.
+/// The QP with contact rows only, solved exactly by a primal-dual active-set
+/// iteration started from the interior-point duals `z` (P factored in
+/// `ldlt`): each trial active set is solved as equalities through the
+/// small Schur complement G P⁻¹ Gᵀ (one sparse solve per row), a row with a
+/// negative force leaves it, the most violated other row joins it. Returns
+/// the step and the contact forces, or None if it does not settle.
+///
+/// With `indefinite = Some(k)` the factored matrix is the true Hessian with
+/// k negative eigenvalues, and the answer is kept only if the Hessian is
+/// positive definite on the tangent space of the active contacts: by
+/// Haynsworth, the KKT matrix has inertia In(W) + In(−S), which must hold
+/// exactly m negative eigenvalues, so S needs m − k positive ones.
 fn polish_contacts(
-    newton: &mut Newton,
+    ldlt: &mut Ldlt,
     q: &[f64],
     gap_rows: &[Vec<(usize, f64)>],
     gaps: &[Gap],
     z: &[f64],
+    indefinite: Option<usize>,
 ) -> Option<(Vec<f64>, Vec<f64>)> {
     let n = q.len();
     let zmax = z.iter().fold(0.0f64, |a, b| a.max(*b));
     let mut active: Vec<usize> = (0..gaps.len())
-        .filter(|&k| z[k] > 1e-6 * zmax && zmax > 0.0)
+        .filter(|&k| zmax > 0.0 && z[k] > 1e-3 * zmax)
         .collect();
-    for _ in 0..3 {
-        if active.is_empty() {
-            return None;
-        }
-        let dense = |row: &[(usize, f64)]| {
-            let mut v = vec![0.0; n];
-            for &(d, x) in row {
-                v[d] += x;
+    let dot = |row: &[(usize, f64)], v: &[f64]| row.iter().map(|&(d, x)| x * v[d]).sum::<f64>();
+    let mut pq = q.to_vec();
+    ldlt.solve_in_place(&mut pq);
+    // P⁻¹ gᵀ per row, computed when the row first joins
+    let mut pg: Vec<Option<Vec<f64>>> = vec![None; gaps.len()];
+    let tol = 1e-12 * gaps.iter().map(|g| g.gap.abs()).fold(1e-3, f64::max);
+    for _ in 0..4 * gaps.len() + 4 {
+        for &k in &active {
+            if pg[k].is_none() {
+                let mut v = vec![0.0; n];
+                for &(d, x) in &gap_rows[k] {
+                    v[d] += x;
+                }
+                ldlt.solve_in_place(&mut v);
+                pg[k] = Some(v);
             }
-            v
-        };
-        // P⁻¹ q and P⁻¹ Gᵀ (columns)
-        let mut pq = q.to_vec();
-        newton.ldlt.solve_in_place(&mut pq);
-        let pg: Vec<Vec<f64>> = active
-            .iter()
-            .map(|&k| {
-                let mut v = dense(&gap_rows[k]);
-                newton.ldlt.solve_in_place(&mut v);
-                v
-            })
-            .collect();
+        }
         let m = active.len();
-        let dot = |row: &[(usize, f64)], v: &[f64]| row.iter().map(|&(d, x)| x * v[d]).sum::<f64>();
-        let s = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&gap_rows[active[i]], &pg[j]));
+        let column = |i: usize| pg[active[i]].as_deref().unwrap();
+        let s = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&gap_rows[active[i]], column(j)));
         let rhs = nalgebra::DVector::from_fn(m, |i, _| {
             dot(&gap_rows[active[i]], &pq) - gaps[active[i]].gap
         });
-        let zs = s.lu().solve(&rhs)?;
-        if let Some(i) = (0..m).find(|&i| zs[i] < 0.0) {
+        let zs = if m > 0 {
+            s.clone().lu().solve(&rhs)?
+        } else {
+            nalgebra::DVector::zeros(0)
+        };
+        if let Some(i) = (0..m)
+            .filter(|&i| zs[i] < 0.0)
+            .min_by(|&a, &b| zs[a].total_cmp(&zs[b]))
+        {
             active.remove(i);
             continue;
         }
         let mut d: Vec<f64> = pq.iter().map(|x| -x).collect();
-        for (i, v) in pg.iter().enumerate() {
-            d.iter_mut().zip(v).for_each(|(x, y)| *x += zs[i] * y);
+        for i in 0..m {
+            d.iter_mut()
+                .zip(column(i))
+                .for_each(|(x, y)| *x += zs[i] * y);
+        }
+        // the other contacts must stay open (linearised)
+        let violated = (0..gaps.len())
+            .filter(|k| !active.contains(k))
+            .map(|k| (k, gaps[k].gap + dot(&gap_rows[k], &d)))
+            .filter(|&(_, g)| g < -tol)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((k, _)) = violated {
+            active.push(k);
+            continue;
+        }
+        if let Some(k) = indefinite {
+            let positive = if m == 0 {
+                0
+            } else {
+                s.symmetric_eigenvalues()
+                    .iter()
+                    .filter(|v| **v > 0.0)
+                    .count()
+            };
+            if k > m || positive != m - k {
+                return None;
+            }
         }
         let mut full = vec![0.0; gaps.len()];
         for (i, &k) in active.iter().enumerate() {
             full[k] = zs[i];
         }
-        // the polished step must keep the other contacts open (linearised)
-        let ok = (0..gaps.len())
-            .filter(|k| !active.contains(k))
-            .all(|k| gaps[k].gap + dot(&gap_rows[k], &d) >= -1e-12);
-        return ok.then_some((d, full));
+        return Some((d, full));
     }
     None
 }
