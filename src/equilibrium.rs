@@ -154,6 +154,40 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
                 |_| Vector3::x(),
             )
         }
+        InitialShape::Trefoil => {
+            let mut state = RodState::from_curve(
+                n,
+                clamps,
+                crate::model::trefoil::trefoil_centreline(clamps.end_point()),
+                |_| Vector3::x(),
+            );
+            // uniform twist, with the whole turns that give the asked link:
+            // m_i = c at every vertex, n c = φ + reference twist at the end
+            let target = init.link.unwrap_or(3) as f64 + clamps.phi_over_2pi();
+            let rt = state.reference_twist[n];
+            let set = |state: &mut RodState, turns: f64| {
+                let c = (clamps.phi + rt + 2.0 * std::f64::consts::PI * turns) / n as f64;
+                for j in 1..n {
+                    state.theta[j] = j as f64 * c;
+                }
+                state.reference_twist[n] = rt + 2.0 * std::f64::consts::PI * turns;
+            };
+            set(&mut state, 0.0);
+            let shape = Shape::of(&state, &Measure::of(scene));
+            if shape.knot.determinant != 3 {
+                bail!(
+                    "initial.shape = \"trefoil\": at z* = {}, δ = {} the guide curve's ray \
+                     closure is not a trefoil (knot determinant {}); start from the \
+                     paper's clamps (z* ≈ 0.115, δ ≈ 0.05) and load from there",
+                    clamps.z_star,
+                    clamps.delta,
+                    shape.knot.determinant
+                );
+            }
+            let turns = (target - state.twist() - shape.writhe).round();
+            set(&mut state, turns);
+            state
+        }
         InitialShape::Shooting => {
             let (mut n0, mut m0) = (
                 Vector3::from(init.n0.context("initial.n0 missing")?),

@@ -323,9 +323,10 @@ pub fn run_loading(
                     Ok(!t.report.contacts.is_empty())
                 })
                 .with_context(context)?;
+                let names: Vec<&str> = eq.contacts.iter().map(|c| c.obstacle.as_str()).collect();
                 let detail = format!(
                     "contacts {} → none (total force {:.3} before)",
-                    eq.contacts.len(),
+                    names.join(", "),
                     eq.contact_force
                 );
                 events.push(path_event("contact_lost", &hi, eq.twist, leg, detail));

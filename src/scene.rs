@@ -155,6 +155,10 @@ pub struct InitialSpec {
     /// buckling (b in the lab frame).
     #[serde(default)]
     pub bump: Option<[f64; 3]>,
+    /// Trefoil: the integer part of the link (Tw + Wr of the ray closure,
+    /// less φ/2π) to give it; default 3, the paper's configuration A.
+    #[serde(default)]
+    pub link: Option<i64>,
 }
 
 /// Kinds of initial shape.
@@ -172,6 +176,9 @@ pub enum InitialShape {
     /// clamps of the scene.
     #[serde(rename = "double_ring")]
     DoubleRing,
+    /// An open trefoil tied around the rays (1.5 turns around the upper ray),
+    /// uniformly twisted so that the ray closure's link is `initial.link`.
+    Trefoil,
 }
 
 /// `[stability]`

@@ -770,6 +770,14 @@ fn contact_table(scenes: &Path) -> Result<String> {
         "| A: min self-distance | {:.4} (h = 0.005) | > h |",
         a.min_self_distance
     )?;
+    let find_with = |kind: &str, leg: usize, detail: &str| {
+        events
+            .iter()
+            .filter(|e| e.kind == kind && e.branch == leg && e.detail.contains(detail))
+            .map(|e| format!("{:.5}", e.phi_over_2pi))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     let find = |kind: &str, leg: usize| {
         events
             .iter()
@@ -780,23 +788,33 @@ fn contact_table(scenes: &Path) -> Result<String> {
     };
     writeln!(
         s,
-        "| B: contact force reaches zero (up) | φ/2π = {} | 0.768 |",
-        find("contact_lost", 1)
+        "| B: ray contact force reaches zero (up) | φ/2π = {} | 0.768 |",
+        find_with("contact_lost", 0, "ray")
+    )?;
+    let self_lost = find_with("contact_lost", 0, "self");
+    writeln!(
+        s,
+        "| self-contact lost (up; near X the strands touch instead of crossing) | φ/2π = {} | — (no contact in the paper's X) |",
+        if self_lost.is_empty() {
+            "none".to_string()
+        } else {
+            self_lost
+        }
     )?;
     writeln!(
         s,
         "| jumps on the way up | φ/2π = {} | at B |",
-        find("jump", 1)
+        find("jump", 0)
     )?;
     writeln!(
         s,
         "| C: walls on the way up (W1, W2) | φ/2π = {} | 0.774, 0.82 |",
-        find("wall", 1)
+        find("wall", 0)
     )?;
     writeln!(
         s,
         "| back down: jumps | φ/2π = {} | at S (no return to B) |",
-        find("jump", 2)
+        find("jump", 1)
     )?;
     Ok(s)
 }

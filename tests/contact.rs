@@ -73,8 +73,9 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
                 .all(|c| c.force > 0.0 && c.gap > -1e-6 * h)
         );
     }
-    // A: two contacts, one with each ray, at s ≈ 0.17 and 0.83
-    let a = &eqs[80];
+    // A: the generated trefoil relaxed at φ = 0: two contacts, one with each
+    // ray, at s ≈ 0.17 and 0.83
+    let a = &eqs[0];
     assert!(a.phi_over_2pi.abs() < 1e-12);
     assert_eq!(a.contacts.len(), 2, "{:?}", a.contacts);
     let (lo, hi) = (&a.contacts[0], &a.contacts[1]);
@@ -90,7 +91,7 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     // B: the contact force reaches zero at φ/2π ≈ 0.768 and the rod jumps
     let lost = events
         .iter()
-        .find(|e| e.kind == "contact_lost" && e.branch == 1)
+        .find(|e| e.kind == "contact_lost" && e.branch == 0)
         .expect("contact lost on the way up");
     assert!(
         (lost.phi_over_2pi - 0.768).abs() < 0.01,
@@ -100,7 +101,7 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     let jump = events
         .iter()
         .find(|e| {
-            e.kind == "jump" && e.branch == 1 && (e.phi_over_2pi - lost.phi_over_2pi).abs() < 1e-3
+            e.kind == "jump" && e.branch == 0 && (e.phi_over_2pi - lost.phi_over_2pi).abs() < 1e-3
         })
         .expect("a jump at B");
     let _ = jump;
@@ -108,7 +109,7 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     // (contact-free continuation of fig3_kirchhoff at N = 100: 0.77411, 0.81862)
     let walls: Vec<f64> = events
         .iter()
-        .filter(|e| e.kind == "wall" && e.branch == 1)
+        .filter(|e| e.kind == "wall" && e.branch == 0)
         .map(|e| e.phi_over_2pi)
         .collect();
     assert_eq!(walls.len(), 2, "{events:?}");
@@ -118,14 +119,13 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     );
     let c = eqs
         .iter()
-        .skip(81)
-        .find(|e| e.phi_over_2pi > walls[0] + 0.005)
+        .find(|e| e.leg == 0 && e.phi_over_2pi > walls[0] + 0.005)
         .unwrap();
     assert!(c.contacts.is_empty() && c.stable && c.good_knot);
     // back down: no jump back to B, but at S (≈ 0.751)
     let down: Vec<&Event> = events
         .iter()
-        .filter(|e| e.kind == "jump" && e.branch == 2)
+        .filter(|e| e.kind == "jump" && e.branch == 1)
         .collect();
     assert_eq!(down.len(), 1, "{events:?}");
     assert!((down[0].phi_over_2pi - 0.751).abs() < 0.005);
@@ -269,4 +269,29 @@ fn gap_hessian_matches_finite_differences() {
             assert!(row.abs() < 1e-9, "translation row {k}: {row}");
         }
     }
+}
+
+#[test]
+fn trefoil_generator_is_a_trefoil_or_says_why_not() {
+    // at the paper's clamps the generated curve's ray closure is a trefoil
+    // with link 3; where the guide curve does not close into one, a clear
+    // error rather than some other knot
+    let text = |z: f64| {
+        format!(
+            "[model]\nK2 = 3.0\nK3 = 3.0\nsegments = 60\n\
+             [clamps]\nz_star = {z}\ndelta = 0.05\nphi_over_2pi = 0.0\n\
+             [initial]\nshape = \"trefoil\"\n"
+        )
+    };
+    let scene = Scene::parse(&text(0.115)).unwrap();
+    let model = scene.rod_model(None);
+    let state = knotrod::equilibrium::initial_state(&scene, &model).unwrap();
+    let shape = knotrod::equilibrium::Shape::of(&state, &knotrod::equilibrium::Measure::of(&scene));
+    assert_eq!(shape.knot.determinant, 3);
+    assert!((state.twist() + shape.writhe - 3.0).abs() < 1e-9);
+    let err = solve_scene(&Scene::parse(&text(0.3)).unwrap(), None).unwrap_err();
+    assert!(
+        format!("{err:#}").contains("initial.shape = \"trefoil\""),
+        "{err:#}"
+    );
 }

@@ -5,3 +5,4 @@ pub mod frames;
 pub mod jet;
 pub mod rod;
 pub mod shooting;
+pub mod trefoil;
