@@ -119,7 +119,8 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     );
     let c = eqs
         .iter()
-        .find(|e| e.leg == 0 && e.phi_over_2pi > walls[0] + 0.005)
+        // (the first such state is on the way up: that leg comes first)
+        .find(|e| e.phi_over_2pi > walls[0] + 0.005)
         .unwrap();
     assert!(c.contacts.is_empty() && c.stable && c.good_knot);
     // back down: no jump back to B, but at S (≈ 0.751)
