@@ -96,18 +96,30 @@ pub struct BranchRun<'a, 'r> {
     previous: Option<Equilibrium>,
 }
 
-fn event(kind: &str, p: &Point, branch: usize, detail: String) -> Event {
-    let c = p.state.clamps;
-    Event {
-        kind: kind.into(),
-        label: String::new(),
-        phi_over_2pi: c.phi_over_2pi(),
-        z_star: c.z_star,
-        delta: c.delta,
-        twist: p.state.twist(),
-        branch,
-        detail,
+impl Event {
+    /// An event of `kind` at clamps `c`, where the twist is `twist`.
+    pub fn at(
+        kind: &str,
+        c: &crate::model::rod::Clamps,
+        twist: f64,
+        branch: usize,
+        detail: String,
+    ) -> Event {
+        Event {
+            kind: kind.into(),
+            label: String::new(),
+            phi_over_2pi: c.phi_over_2pi(),
+            z_star: c.z_star,
+            delta: c.delta,
+            twist,
+            branch,
+            detail,
+        }
     }
+}
+
+fn event(kind: &str, p: &Point, branch: usize, detail: String) -> Event {
+    Event::at(kind, &p.state.clamps, p.state.twist(), branch, detail)
 }
 
 impl<'a, 'r> BranchRun<'a, 'r> {

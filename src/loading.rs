@@ -187,16 +187,7 @@ fn locate_on_path(
 
 /// An event of a loading path at clamps `c` (its `branch` is the path's leg).
 fn path_event(kind: &str, c: &Clamps, twist: f64, leg: usize, detail: String) -> Event {
-    Event {
-        kind: kind.into(),
-        label: String::new(),
-        phi_over_2pi: c.phi_over_2pi(),
-        z_star: c.z_star,
-        delta: c.delta,
-        twist,
-        branch: leg,
-        detail,
-    }
+    Event::at(kind, c, twist, leg, detail)
 }
 
 /// Link change between two equilibria beyond the clamp's own turn.

@@ -235,8 +235,6 @@ impl ContactModel {
         kept
     }
 
-    /// The gap of a candidate (same segments and obstacle) for the centreline
-    /// `points` of another state.
     /// The four end points of a contact's segment pair (the rod's segment
     /// first; a ray or obstacle contributes fixed points).
     pub fn pair_points(&self, points: &[Vector3<f64>], c: &Gap) -> [Vector3<f64>; 4] {
@@ -253,22 +251,10 @@ impl ContactModel {
         [points[k], points[k + 1], other[0], other[1]]
     }
 
+    /// The gap of a candidate (same segments and obstacle) for the centreline
+    /// `points` of another state.
     pub fn gap_at(&self, points: &[Vector3<f64>], c: &Gap) -> f64 {
-        let k = c.segments[0];
-        let other = match c.obstacle {
-            Obstacle::RayBottom => [Vector3::zeros(), -self.ray_length * Vector3::z()],
-            Obstacle::RayTop => {
-                let end = *points.last().unwrap();
-                [end, end + self.ray_length * Vector3::z()]
-            }
-            Obstacle::Fixed(o) => self.obstacles[o],
-            Obstacle::SelfAt(_) => [points[c.segments[1]], points[c.segments[1] + 1]],
-        };
-        pair_gap(
-            &[points[k], points[k + 1], other[0], other[1]],
-            self.diameter,
-        )
-        .0
+        pair_gap(&self.pair_points(points, c), self.diameter).0
     }
 }
 
