@@ -390,14 +390,17 @@ fn hold_contacts(
         .iter()
         .map(|&s| values[s].abs())
         .fold(0.0, f64::max);
-    Some(Widened::new(
+    let gaps: Vec<&crate::geometry::contact::Gap> = held.iter().map(|(g, _)| g).collect();
+    let mut wide = Widened::new(energy, &gaps);
+    wide.fill(
         energy,
         values,
         model,
         state,
         held.iter().map(|(g, z)| (g, *z)),
         1e3 * max_diag,
-    ))
+    );
+    Some(wide)
 }
 
 /// Measure an equilibrium found by `newton` (its energy is reused for the Hessian).

@@ -124,7 +124,9 @@ fn qp_settings() -> DefaultSettings<f64> {
 /// A Hessian on the energy's pattern widened by contact couplings (a
 /// self-contact couples distant nodes), with the contacts' terms added: the
 /// Lagrangian's curvature −z ∇²g of each contact with force z, and a penalty
-/// ρ ∇g ∇gᵀ (ρ > 0 holds the contacts in a stability analysis).
+/// ρ ∇g ∇gᵀ (ρ > 0 holds the contacts in a stability analysis). The pattern
+/// and the symbolic factorisation depend only on which node groups touch, so
+/// they are kept while the contact set stays the same.
 pub struct Widened {
     /// The widened pattern.
     pub pattern: SymmetricPattern,
@@ -132,53 +134,84 @@ pub struct Widened {
     pub values: Vec<f64>,
     /// Its factorisation workspace.
     pub ldlt: Ldlt,
+    /// The nodes of each contact stencil it was built for.
+    contacts: Vec<Vec<usize>>,
+    /// Slot in the widened pattern of each slot of the energy's pattern.
+    energy_slots: Vec<usize>,
+}
+
+/// Nodes whose positions a contact's gap depends on.
+fn contact_nodes(g: &Gap) -> Vec<usize> {
+    let [i, j] = g.segments;
+    if matches!(g.obstacle, Obstacle::SelfAt(_)) {
+        vec![i, i + 1, j, j + 1]
+    } else {
+        vec![i, i + 1]
+    }
 }
 
 impl Widened {
-    /// Widen the energy Hessian `values` by the contacts `(gap, force)`.
-    pub fn new<'g>(
-        energy: &RodEnergy,
-        values: &[f64],
-        model: &ContactModel,
-        state: &RodState,
-        contacts: impl Iterator<Item = (&'g Gap, f64)> + Clone,
-        rho: f64,
-    ) -> Self {
+    /// The widened pattern (and its symbolic factorisation) for `gaps`.
+    pub fn new(energy: &RodEnergy, gaps: &[&Gap]) -> Self {
         let map = energy.map;
         let n = energy.model.segments;
-        let nodes = |g: &Gap| -> Vec<usize> {
-            let [i, j] = g.segments;
-            if matches!(g.obstacle, Obstacle::SelfAt(_)) {
-                vec![i, i + 1, j, j + 1]
-            } else {
-                vec![i, i + 1]
-            }
-        };
-        let dofs = |k: usize| -> [Option<usize>; 3] {
-            match map.node(k) {
-                Some(d) => [Some(d), Some(d + 1), Some(d + 2)],
-                None => [None; 3],
-            }
-        };
+        let contacts: Vec<Vec<usize>> = gaps.iter().map(|g| contact_nodes(g)).collect();
         let mut stencils: Vec<Vec<Option<usize>>> = (1..=n)
             .map(|i| map.vertex_stencil(i).to_vec())
             .chain((1..n).map(|j| map.edge_stencil(j).to_vec()))
             .collect();
-        for (g, _) in contacts.clone() {
-            stencils.push(nodes(g).into_iter().flat_map(dofs).collect());
+        for nodes in &contacts {
+            stencils.push(nodes.iter().flat_map(|&k| node_dofs(energy, k)).collect());
         }
         let pattern = SymmetricPattern::from_stencils(map.len(), &stencils);
-        let mut wide = vec![0.0; pattern.nnz()];
         let old = &energy.pattern.matrix;
+        let mut energy_slots = Vec::with_capacity(old.nnz());
         for c in 0..old.ncols() {
-            let range = old.col_offsets()[c]..old.col_offsets()[c + 1];
-            for (&r, v) in old.row_indices()[range.clone()].iter().zip(&values[range]) {
-                wide[pattern.slot(r, c).expect("widened pattern holds the old")] += v;
+            for &r in &old.row_indices()[old.col_offsets()[c]..old.col_offsets()[c + 1]] {
+                energy_slots.push(pattern.slot(r, c).expect("widened pattern holds the old"));
             }
+        }
+        let ldlt = Ldlt::new(&pattern);
+        Widened {
+            values: vec![0.0; pattern.nnz()],
+            pattern,
+            ldlt,
+            contacts,
+            energy_slots,
+        }
+    }
+
+    /// Whether this pattern was built for exactly these contacts.
+    pub fn fits(&self, gaps: &[&Gap]) -> bool {
+        self.contacts.len() == gaps.len()
+            && self
+                .contacts
+                .iter()
+                .zip(gaps)
+                .all(|(c, g)| *c == contact_nodes(g))
+    }
+
+    /// Fill with the energy Hessian `values` and the contacts' terms; the
+    /// contacts `(gap, force)` are those it was built for, in order.
+    pub fn fill<'g>(
+        &mut self,
+        energy: &RodEnergy,
+        values: &[f64],
+        model: &ContactModel,
+        state: &RodState,
+        contacts: impl Iterator<Item = (&'g Gap, f64)>,
+        rho: f64,
+    ) {
+        self.values.iter_mut().for_each(|v| *v = 0.0);
+        for (&slot, v) in self.energy_slots.iter().zip(values) {
+            self.values[slot] += v;
         }
         let (points, _) = state.centreline();
         for (g, z) in contacts {
-            let local: Vec<Option<usize>> = nodes(g).into_iter().flat_map(dofs).collect();
+            let local: Vec<Option<usize>> = contact_nodes(g)
+                .into_iter()
+                .flat_map(|k| node_dofs(energy, k))
+                .collect();
             let curvature = (z > 0.0).then(|| gap_hessian(&model.pair_points(&points, g)));
             let gradient: Vec<f64> = g
                 .gradient
@@ -200,16 +233,22 @@ impl Widened {
                     if rho > 0.0 {
                         v += rho * gradient[a] * gradient[b];
                     }
-                    wide[pattern.slot(*da, *db).expect("contact stencil in pattern")] += v;
+                    let slot = self
+                        .pattern
+                        .slot(*da, *db)
+                        .expect("contact stencil in pattern");
+                    self.values[slot] += v;
                 }
             }
         }
-        let ldlt = Ldlt::new(&pattern);
-        Widened {
-            pattern,
-            values: wide,
-            ldlt,
-        }
+    }
+}
+
+/// The 3 translational dofs of node k (None where it is clamped).
+fn node_dofs(energy: &RodEnergy, k: usize) -> [Option<usize>; 3] {
+    match energy.map.node(k) {
+        Some(d) => [Some(d), Some(d + 1), Some(d + 2)],
+        None => [None; 3],
     }
 }
 
@@ -291,6 +330,9 @@ pub fn minimize(
         None => settings.max_step,
     };
     let mut solver: Option<DefaultSolver<f64>> = None;
+    // the widened Hessian of the last contact set (pattern and symbolic
+    // factorisation reused while the set is unchanged)
+    let mut wide: Option<Widened> = None;
     let mut report = NewtonReport::start();
     let mut trial = state.clone();
     let mut shift;
@@ -381,26 +423,34 @@ pub fn minimize(
         // with contacts the QP's Hessian is that of the Lagrangian E − Σ z g
         // (the contacts' curvature, forces from the last QP), on the energy's
         // pattern widened by the contact couplings
-        let mut wide = match &newton.contact {
-            Some(model) if !gaps.is_empty() => Some(Widened::new(
-                &newton.energy,
-                &values,
-                model,
-                state,
-                gaps.iter().map(|g| {
-                    let z = forces
+        let widened = match &newton.contact {
+            Some(model) if !gaps.is_empty() => {
+                let refs: Vec<&Gap> = gaps.iter().collect();
+                if !wide.as_ref().is_some_and(|w| w.fits(&refs)) {
+                    wide = Some(Widened::new(&newton.energy, &refs));
+                }
+                let z = |g: &Gap| {
+                    forces
                         .iter()
                         .find(|f| same_pair(&f.0, g))
-                        .map_or(0.0, |f| f.1);
-                    (g, z)
-                }),
-                0.0,
-            )),
-            _ => None,
+                        .map_or(0.0, |f| f.1)
+                };
+                let w = wide.as_mut().expect("built above");
+                w.fill(
+                    &newton.energy,
+                    &values,
+                    model,
+                    state,
+                    gaps.iter().map(|g| (g, z(g))),
+                    0.0,
+                );
+                true
+            }
+            _ => false,
         };
         let (pat, vals, ldlt): (&SymmetricPattern, &mut Vec<f64>, &mut Ldlt) = match wide.as_mut() {
-            Some(w) => (&w.pattern, &mut w.values, &mut w.ldlt),
-            None => (&newton.energy.pattern, &mut values, &mut newton.ldlt),
+            Some(w) if widened => (&w.pattern, &mut w.values, &mut w.ldlt),
+            _ => (&newton.energy.pattern, &mut values, &mut newton.ldlt),
         };
         // convexify: W + shift I positive definite, the shift just beyond the
         // lowest eigenvalue (a larger one would make a falling rod creep)
