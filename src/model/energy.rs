@@ -94,26 +94,18 @@ pub fn edge_variables(state: &RodState, j: usize) -> [f64; 3] {
     [e.x, e.y, e.z]
 }
 
-/// Node-variable index (x_{i-1}, x_i, x_{i+1}, θ_{i-1}, θ_i: 11) → list of
-/// (edge-variable index, coefficient) with e_{i-1} = x_i − x_{i−1}, e_i = x_{i+1} − x_i.
-fn vertex_chain(a: usize) -> [(usize, f64); 2] {
-    match a {
-        0..=2 => [(a, -1.0), (usize::MAX, 0.0)],
-        3..=5 => [(a - 3, 1.0), (a, -1.0)],
-        6..=8 => [(a - 3, 1.0), (usize::MAX, 0.0)],
-        9 => [(6, 1.0), (usize::MAX, 0.0)],
-        _ => [(7, 1.0), (usize::MAX, 0.0)],
-    }
-}
-
-/// Map an 8-variable gradient to the 11 node variables.
+/// Map an 8-variable gradient (e_{i-1}, e_i, θ_{i-1}, θ_i) to the 11 node
+/// variables (x_{i-1}, x_i, x_{i+1}, θ_{i-1}, θ_i), with e_{i-1} = x_i − x_{i−1}
+/// and e_i = x_{i+1} − x_i.
 fn vertex_gradient_to_nodes(g8: &[f64]) -> [f64; 11] {
     let mut g = [0.0; 11];
-    for (a, ga) in g.iter_mut().enumerate() {
-        for &(k, alpha) in vertex_chain(a).iter().filter(|c| c.0 != usize::MAX) {
-            *ga += alpha * g8[k];
-        }
+    for c in 0..3 {
+        g[c] = -g8[c];
+        g[3 + c] = g8[c] - g8[3 + c];
+        g[6 + c] = g8[3 + c];
     }
+    g[9] = g8[6];
+    g[10] = g8[7];
     g
 }
 
