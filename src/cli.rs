@@ -536,6 +536,46 @@ fn write_map(map: &crate::map::Map, json: &Path) -> Result<()> {
                 .unwrap_or_default()
         )?;
     }
+    if let Some(t) = &map.traced {
+        writeln!(
+            out,
+            "traced boundary: {} pieces, {} points, {} equilibria, {}",
+            t.pieces.len(),
+            t.points,
+            t.equilibria,
+            if t.closed { "closed" } else { "open" }
+        )?;
+        for p in &t.pieces {
+            let (a, b) = (p.points[0], p.points[p.points.len() - 1]);
+            writeln!(
+                out,
+                "  {:<5} ({}) from ({:.5}, {:.5}) to ({:.5}, {:.5}), {} points",
+                p.label,
+                p.condition,
+                a[0],
+                a[1],
+                b[0],
+                b[1],
+                p.points.len()
+            )?;
+        }
+        if let Some(a) = t.area {
+            writeln!(out, "  enclosed area {a:.6} (grid: {:.6})", map.good_area)?;
+        }
+        for (k, v) in &t.bounding_box {
+            writeln!(out, "  traced {k} in [{:.5}, {:.5}]", v[0], v[1])?;
+        }
+        if let Some(g) = &t.grid_check {
+            writeln!(
+                out,
+                "  grid check: {} interval ends, largest φ/2π deviation {:.2e}, lines counting other ends: {:?}",
+                g.ends, g.max_phi_deviation, g.lines_with_other_count
+            )?;
+        }
+        if let Some(why) = &t.stopped {
+            writeln!(out, "  walk stopped: {why}")?;
+        }
+    }
     writeln!(out, "map written to {}", json.display())?;
     for f in crate::plot::island_map(&json.with_extension(""), map)? {
         writeln!(out, "plot written to {}", f.display())?;
@@ -628,6 +668,19 @@ fn map_plane(
     };
     // computed lines are kept beside the output: an interrupted map resumes
     let cache = json.with_extension("lines");
+    // the boundary walk is one sequential computation: shard 0 carries it
+    let traced = match shard {
+        Some((i, _)) if i != 0 => None,
+        _ => {
+            let spinner = indicatif::ProgressBar::new_spinner();
+            let t = crate::boundary::trace_cached(scene, &spec, segments, &cache, &|k, on| {
+                spinner.set_message(format!("tracing the boundary: point {k}, on {on}"));
+                spinner.tick();
+            })?;
+            spinner.finish_and_clear();
+            Some(t)
+        }
+    };
     let progress = indicatif::ProgressBar::new(indices.len() as u64);
     progress.set_style(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} lines, ETA {eta} — {msg}")
@@ -651,6 +704,7 @@ fn map_plane(
                 phi_range: cont.range,
                 shard: sh,
                 lines,
+                traced,
             };
             std::fs::write(json, serde_json::to_string_pretty(&part)? + "\n")
                 .with_context(|| format!("writing {}", json.display()))?;
@@ -664,7 +718,7 @@ fn map_plane(
             Ok(None)
         }
         None => {
-            let map = crate::map::assemble(name, &spec, cont.range, lines);
+            let map = crate::map::assemble(name, &spec, cont.range, lines, traced);
             write_map(&map, json)?;
             Ok(Some(map))
         }

@@ -4,6 +4,7 @@
 pub mod analytic;
 pub mod asymptotics;
 pub mod bench;
+pub mod boundary;
 pub mod branch;
 pub mod cli;
 pub mod equilibrium;

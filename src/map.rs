@@ -103,8 +103,15 @@ pub struct Map {
     pub parameter: String,
     /// Lines, by increasing index.
     pub lines: Vec<Line>,
-    /// Named boundary curves: (swept value, φ/2π) points.
+    /// Named boundary curves, (swept value, φ/2π) points: the traced
+    /// boundary's pieces when it was traced, else the grid's.
     pub boundaries: BTreeMap<String, Vec<[f64; 2]>>,
+    /// Boundary curves chained from the grid's interval ends (the check).
+    #[serde(default)]
+    pub grid_boundaries: BTreeMap<String, Vec<[f64; 2]>>,
+    /// The boundary traced by two-parameter continuation from the start.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub traced: Option<crate::boundary::Traced>,
     /// Classified grid: rows = lines, columns = `grid_phi`.
     pub grid: Vec<Vec<Class>>,
     /// φ/2π of the grid columns.
@@ -461,6 +468,7 @@ pub fn assemble(
     spec: &MapSpec,
     phi_range: [f64; 2],
     mut lines: Vec<Line>,
+    traced: Option<crate::boundary::Traced>,
 ) -> Map {
     lines.sort_by_key(|l| l.index);
     lines.dedup_by_key(|l| l.index);
@@ -499,7 +507,19 @@ pub fn assemble(
             area += 0.5 * (widths[k] + widths[k - 1]) * (l.value - lines[k - 1].value);
         }
     }
-    let boundaries = chain_boundaries(&ends);
+    let grid_boundaries = chain_boundaries(&ends);
+    let traced = traced.map(|mut t| {
+        t.grid_check = crate::boundary::grid_check(&t, &lines);
+        t
+    });
+    let boundaries = match &traced {
+        Some(t) if !t.pieces.is_empty() => t
+            .pieces
+            .iter()
+            .map(|p| (p.label.clone(), p.points.clone()))
+            .collect(),
+        _ => grid_boundaries.clone(),
+    };
     let mut bounding_box = BTreeMap::new();
     if vlo.is_finite() {
         bounding_box.insert(spec.parameter.name().to_string(), [vlo, vhi]);
@@ -510,6 +530,8 @@ pub fn assemble(
         parameter: spec.parameter.name().into(),
         lines,
         boundaries,
+        grid_boundaries,
+        traced,
         grid,
         grid_phi,
         good_area: area,
@@ -608,22 +630,29 @@ pub struct Partial {
     pub shard: (usize, usize),
     /// Its lines.
     pub lines: Vec<Line>,
+    /// The traced boundary (shard 0 computes it).
+    #[serde(default)]
+    pub traced: Option<crate::boundary::Traced>,
 }
 
 /// Merge partial results into a map.
 pub fn merge(parts: &[PathBuf]) -> Result<Map> {
     let mut all = Vec::new();
     let mut head: Option<Partial> = None;
+    let mut traced = None;
     for p in parts {
         let text =
             std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))?;
         let part: Partial = serde_json::from_str(&text)
             .with_context(|| format!("{} is not a partial map", p.display()))?;
         all.extend(part.lines.clone());
+        if part.traced.is_some() {
+            traced = part.traced.clone();
+        }
         head.get_or_insert(part);
     }
     let h = head.context("merge needs at least one partial result")?;
-    let map = assemble(&h.scene, &h.spec, h.phi_range, all);
+    let map = assemble(&h.scene, &h.spec, h.phi_range, all, traced);
     let missing: Vec<usize> = (0..h.spec.lines)
         .filter(|k| !map.lines.iter().any(|l| l.index == *k))
         .collect();

@@ -447,7 +447,7 @@ fn island_table_of(scenes: &Path, name: &str) -> Result<String> {
     let indices: Vec<usize> = (0..spec.lines).collect();
     let lines = crate::map::compute_lines(&scene, &spec, &indices, None, &cache, &|_| {})?;
     let _ = std::fs::remove_dir_all(&cache);
-    let map = crate::map::assemble(name, &spec, cont.range, lines);
+    let map = crate::map::assemble(name, &spec, cont.range, lines, None);
     let mut s = String::new();
     writeln!(
         s,
@@ -698,7 +698,9 @@ fn map3_table(scenes: &Path) -> Result<String> {
         let idx: Vec<usize> = (0..sspec.lines).collect();
         let lines = crate::map::compute_lines(&slice, &sspec, &idx, None, &cache, &|_| {})?;
         let _ = std::fs::remove_dir_all(&cache);
-        maps.push(crate::map::assemble("fig9", &sspec, cont.range, lines));
+        maps.push(crate::map::assemble(
+            "fig9", &sspec, cont.range, lines, None,
+        ));
     }
     let m3 = crate::map::assemble_3d("fig9_strip_3d", &slices, maps);
     let mut s = String::new();

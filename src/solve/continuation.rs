@@ -6,7 +6,8 @@
 //! continued on the KKT system instead: unknowns (q, λ), the constraint rows
 //! bordered in, stability from the inertia reduced to the tangent space.
 
-use crate::model::rod::{Parameter, RodState};
+use crate::model::energy::ClampVelocity;
+use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::solve::kkt::Kkt;
 use crate::solve::newton::{Newton, SolveError, residual};
 use crate::solve::sparse::Ldlt;
@@ -162,14 +163,9 @@ impl<'a> Tracer<'a> {
     }
 
     /// Apply a step (dofs, then multipliers) and move the clamps.
-    fn step_into(&self, from: &RodState, dq: &[f64], p: f64, next: &mut RodState) {
+    fn step_into(&self, from: &RodState, dq: &[f64], clamps: Clamps, next: &mut RodState) {
         let map = self.newton.energy.map;
-        from.move_into(
-            &map,
-            &dq[..self.dofs],
-            self.parameter.with(&from.clamps, p),
-            next,
-        );
+        from.move_into(&map, &dq[..self.dofs], clamps, next);
         if self.kkt.is_some() {
             for (l, d) in next.multipliers[1..].iter_mut().zip(&dq[self.dofs..]) {
                 *l += d;
@@ -287,7 +283,12 @@ impl<'a> Tracer<'a> {
         for (a, t) in self.a.iter_mut().zip(&tq) {
             *a = sigma * t;
         }
-        self.step_into(&from.state, &self.a, p_pred, &mut state);
+        self.step_into(
+            &from.state,
+            &self.a,
+            self.parameter.with(&from.state.clamps, p_pred),
+            &mut state,
+        );
         let mut offset = vec![0.0; tq.len()];
         let mut p = p_pred;
         for it in 0..=self.settings.max_corrector_iterations {
@@ -343,9 +344,81 @@ impl<'a> Tracer<'a> {
                 return Err(ContinuationError::Corrector(it + 1));
             }
             p += dp;
-            self.step_into(&state, dq, p, &mut next);
+            self.step_into(&state, dq, self.parameter.with(&state.clamps, p), &mut next);
             std::mem::swap(&mut state, &mut next);
             offset.iter_mut().zip(dq).for_each(|(o, d)| *o += d);
+        }
+        Err(ContinuationError::Corrector(
+            self.settings.max_corrector_iterations,
+        ))
+    }
+
+    /// The equilibrium at the clamps `target`, by Newton at fixed clamps from
+    /// the equilibrium `from`. The first step is the linearised move of the
+    /// equilibrium with the clamps (H dq = -(∇E + ∂_c∇E Δc)); the result
+    /// carries its tangent in the tracer's parameter. Used to follow a
+    /// condition across the plane of two parameters (`crate::boundary`).
+    pub fn settle_at(
+        &mut self,
+        from: &RodState,
+        target: Clamps,
+    ) -> Result<Point, ContinuationError> {
+        let n = self.dofs;
+        let mut state = from.clone();
+        if let Some(k) = &self.kkt {
+            state.multipliers.resize(k.constraints + 1, 0.0);
+        }
+        let mut next = state.clone();
+        // the clamps' move as a velocity: ∂_c∇E is linear in it
+        let velocity = ClampVelocity {
+            end: target.end_point() - from.clamps.end_point(),
+            theta: target.phi - from.clamps.phi,
+        };
+        let map = self.newton.energy.map;
+        for it in 0..=self.settings.max_corrector_iterations {
+            crate::solve::counters::NEWTON_ITERATIONS
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let (rel, at_floor) = self.linearise(&state)?;
+            if it > 0 && (rel <= self.settings.tolerance || at_floor) {
+                let negative_count = self.negative_count();
+                let (tangent_q, tangent_p) = self.tangent(None, 1.0);
+                return Ok(Point {
+                    state,
+                    tangent_q,
+                    tangent_p,
+                    negative_count,
+                    iterations: it,
+                    residual: rel,
+                    correction: 0.0,
+                    hessian: self.values.as_slice().into(),
+                });
+            }
+            if it == self.settings.max_corrector_iterations {
+                break;
+            }
+            let mut a = std::mem::take(&mut self.a);
+            a.copy_from_slice(&self.grad);
+            if it == 0 {
+                let energy = &self.newton.energy;
+                let mut fc = vec![0.0; a.len()];
+                energy.gradient_parameter_derivative(&state, &velocity, &mut fc[..n]);
+                if self.kkt.is_some() {
+                    energy.constraint_parameter_derivative(&self.rows, &velocity, &mut fc[n..]);
+                }
+                a.iter_mut().zip(&fc).for_each(|(x, f)| *x += f);
+            }
+            self.solver().solve_in_place(&mut a);
+            a.iter_mut().for_each(|x| *x = -*x);
+            self.a = a;
+            let largest = (0..n)
+                .filter(|&d| map.is_translation(d))
+                .map(|d| self.a[d].abs())
+                .fold(0.0, f64::max);
+            if largest > 0.05 || self.a.iter().any(|v| !v.is_finite()) {
+                return Err(ContinuationError::Corrector(it + 1));
+            }
+            self.step_into(&state, &self.a, target, &mut next);
+            std::mem::swap(&mut state, &mut next);
         }
         Err(ContinuationError::Corrector(
             self.settings.max_corrector_iterations,
