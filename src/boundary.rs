@@ -536,10 +536,22 @@ pub fn trace_island(
         base,
         swept: spec.parameter,
         bounds: [spec.range, cont.range],
-        max_step: cont.max_step.unwrap_or(0.01),
+        max_step: spec.trace_step,
         equilibria: 0,
     };
+    if !(spec.trace_step > 0.0 && spec.trace_step.is_finite()) {
+        bail!("map.trace_step must be positive, not {}", spec.trace_step);
+    }
     let p0 = [spec.parameter.value(&base), base.phi_over_2pi()];
+    if !walk.inside(spec.trace_from.unwrap_or(p0)) {
+        bail!(
+            "the boundary walk's start ({} = {}, φ/2π = {}: map.trace_from or the scene's \
+             start) lies outside the map's range",
+            spec.parameter.name(),
+            spec.trace_from.unwrap_or(p0)[0],
+            spec.trace_from.unwrap_or(p0)[1]
+        );
+    }
     let start = Site {
         p: p0,
         on: p0,
@@ -555,10 +567,19 @@ pub fn trace_island(
         },
     };
     let start = walk.settle(&start, p0).context("the map's start")?;
+    let (start, p0) = match spec.trace_from {
+        Some(p) if p != p0 => {
+            let s = walk
+                .settle(&start, p)
+                .context("from the scene's start to map.trace_from")?;
+            (s, p)
+        }
+        _ => (start, p0),
+    };
     if let Some(f) = walk.failing(&start, None, [0.0, 0.0])? {
         bail!(
-            "the boundary walk starts from a good knot; the scene's start ({} = {}, φ/2π = {}) \
-             fails the test {f:?}",
+            "the boundary walk starts from a good knot (map.trace_from, or the scene's start); \
+             ({} = {}, φ/2π = {}) fails the test {f:?}",
             spec.parameter.name(),
             p0[0],
             p0[1]
@@ -741,6 +762,19 @@ fn walk_around(
     }
 }
 
+/// Two crossing conditions of the same strands, up to a few segments.
+fn same_crossing(a: &Condition, b: &Condition) -> bool {
+    let (Condition::Crossing(a), Condition::Crossing(b)) = (a, b) else {
+        return false;
+    };
+    let near = |x: usize, y: usize| x.abs_diff(y) <= 3;
+    near(a.first, b.first)
+        && match (a.other, b.other) {
+            (Other::Segment(i), Other::Segment(j)) => near(i, j),
+            (x, y) => x == y,
+        }
+}
+
 /// The paper's name of a piece: walls are W1 where the good region lies
 /// above them in φ, W2 where it lies below.
 fn label(c: &Condition, side: f64) -> &'static str {
@@ -754,6 +788,18 @@ fn label(c: &Condition, side: f64) -> &'static str {
 
 /// Name the pieces as the paper does and measure the loop.
 fn finish(walk: &Walk, pieces: Vec<Trail>, closed: bool, stopped: Option<String>) -> Traced {
+    // a crossing followed across neighbouring segment pairs (a corner where
+    // the knot test flickered at a sharp tip) is one curve
+    let mut pieces = pieces;
+    let mut k = 1;
+    while k < pieces.len() {
+        if same_crossing(&pieces[k - 1].0, &pieces[k].0) {
+            let next = pieces.remove(k);
+            pieces[k - 1].1.extend(next.1.into_iter().skip(1));
+        } else {
+            k += 1;
+        }
+    }
     // split the pieces where their name changes (a wall curve turning round
     // the island's tip is W1 on one side and W2 on the other)
     let mut named: Vec<Piece> = Vec::new();

@@ -136,6 +136,13 @@ pub struct MapSpec {
     /// Columns of the classified grid.
     #[serde(default = "default_columns")]
     pub grid_columns: usize,
+    /// A known good knot (parameter, φ/2π) the boundary walk starts from,
+    /// reached from the scene's start in a straight line (default: the start).
+    #[serde(default)]
+    pub trace_from: Option<[f64; 2]>,
+    /// Largest step of the boundary walk in the (parameter, φ/2π) plane.
+    #[serde(default = "default_trace_step")]
+    pub trace_step: f64,
     /// A 3D map: one such map per value of a third parameter.
     #[serde(default)]
     pub slices: Option<SliceSpec>,
@@ -239,6 +246,9 @@ pub fn assemble_3d(scene: &str, spec: &SliceSpec, slices: Vec<Map>) -> Map3 {
 
 fn default_sweep() -> Parameter {
     Parameter::ZStar
+}
+fn default_trace_step() -> f64 {
+    0.005
 }
 fn default_columns() -> usize {
     101
