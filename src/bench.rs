@@ -130,6 +130,16 @@ pub fn run(scenes: &Path) -> Result<Report> {
         let _ = std::fs::remove_dir_all(&cache);
         Ok(())
     })?);
+    // the island's boundary walked by two-parameter continuation (one
+    // sequential computation), on the full map's range
+    workloads.push(timed("figure_7_island_boundary_walk", 100, || {
+        let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
+        let t = crate::boundary::trace_island(&fig7, &spec, Some(100), &|_, _| {})?;
+        if !t.closed {
+            anyhow::bail!("boundary walk did not close: {:?}", t.stopped);
+        }
+        Ok(())
+    })?);
     // per-operation costs on the Appendix D knot resampled at each N
     let mut per: BTreeMap<String, Vec<(usize, f64)>> = BTreeMap::new();
     for n in [200, 400, 800, 1600, 3200] {

@@ -69,6 +69,16 @@ enum Failure {
     Stability,
 }
 
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Failure::Wall => "it is not between the walls",
+            Failure::Knot => "its ray closure is not a trefoil",
+            Failure::Stability => "it is unstable",
+        })
+    }
+}
+
 impl Condition {
     fn failure(&self) -> Failure {
         match self {
@@ -579,7 +589,7 @@ pub fn trace_island(
     if let Some(f) = walk.failing(&start, None, [0.0, 0.0])? {
         bail!(
             "the boundary walk starts from a good knot (map.trace_from, or the scene's start); \
-             ({} = {}, φ/2π = {}) fails the test {f:?}",
+             at {} = {}, φ/2π = {} {f}",
             spec.parameter.name(),
             p0[0],
             p0[1]

@@ -387,8 +387,8 @@ where
         }
     }
     for (name, pts) in &map.boundaries {
-        let mut pts: Vec<(f64, f64)> = pts.iter().map(|p| (p[1], p[0])).collect();
-        pts.sort_by(|a, b| a.1.total_cmp(&b.1));
+        // in order along the curve (traced walks fold; grid chains go by line)
+        let pts: Vec<(f64, f64)> = pts.iter().map(|p| (p[1], p[0])).collect();
         chart
             .draw_series(LineSeries::new(pts.clone(), BLACK.stroke_width(2)))
             .map_err(err)?;
