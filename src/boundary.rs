@@ -48,6 +48,8 @@ pub struct Strands {
     pub other: Other,
     /// Orientation: +1 or −1, so that the good side is positive.
     pub sign: f64,
+    /// Number of centreline segments (for the flip image of the strands).
+    pub segments: usize,
 }
 
 /// A boundary condition: zero on the curve, positive on the good side.
@@ -147,6 +149,15 @@ pub struct Traced {
 }
 
 impl Traced {
+    /// φ/2π where the traced loop crosses the line (swept parameter = v).
+    pub fn cuts(&self, v: f64) -> Vec<f64> {
+        let all: Vec<[f64; 2]> = self.pieces.iter().flat_map(|p| p.points.clone()).collect();
+        all.windows(2)
+            .filter(|w| (w[0][0] <= v) != (w[1][0] <= v))
+            .map(|w| w[0][1] + (v - w[0][0]) / (w[1][0] - w[0][0]) * (w[1][1] - w[0][1]))
+            .collect()
+    }
+
     /// A walk that could not start.
     pub fn failed(why: String) -> Self {
         Traced {
@@ -260,15 +271,50 @@ fn strand_distance(points: &[Vector3<f64>], i: usize, other: Other, reach: f64) 
     (d, (pb - pa).dot(&n) / n.norm().max(1e-300))
 }
 
+impl Strands {
+    /// The same strands, up to 3 segments along each, or their image by
+    /// the flip symmetry (s ↔ 1 − s, the rays swapped): a flip-symmetric
+    /// knot passes through itself at two mirror points at once, so the two
+    /// crossings are one boundary.
+    fn near(&self, first: usize, other: Other) -> bool {
+        // strands crossing at a shallow angle are close over several pairs
+        let close = |x: usize, y: usize| x.abs_diff(y) <= 3;
+        let same = |a: usize, oa: Other, b: usize, ob: Other| {
+            close(a, b)
+                && match (oa, ob) {
+                    (Other::Segment(i), Other::Segment(j)) => close(i, j),
+                    (x, y) => x == y,
+                }
+        };
+        let m = |i: usize| (self.segments - 1).saturating_sub(i);
+        let mirror = match other {
+            Other::Segment(j) => (m(j), Other::Segment(m(first))),
+            Other::BottomRay => (m(first), Other::TopRay),
+            Other::TopRay => (m(first), Other::BottomRay),
+        };
+        same(self.first, self.other, first, other)
+            || same(self.first, self.other, mirror.0, mirror.1)
+    }
+}
+
 /// The strands nearest to passing through each other: the closest pair of
-/// segments at least `gap` apart in arc length, or a segment and a ray.
-fn closest_strands(points: &[Vector3<f64>], arc: &[f64], gap: f64) -> (usize, Other) {
+/// segments at least `gap` apart in arc length, or a segment and a ray,
+/// other than the strands `except` (the crossings the walk is on or tried
+/// already at this corner, in contact
+/// at a corner between two crossings).
+fn closest_strands(
+    points: &[Vector3<f64>],
+    arc: &[f64],
+    gap: f64,
+    except: &[Strands],
+) -> (usize, Other) {
     let reach = 2.0 * crate::geometry::closure::extent(points) + 1.0;
     let segments = points.len() - 1;
+    let skip = |i: usize, o: Other| except.iter().any(|e| e.near(i, o));
     let mut best = (f64::INFINITY, 0, Other::TopRay);
     for i in 0..segments {
         for j in i + 1..segments {
-            if arc[j] - arc[i + 1] >= gap {
+            if arc[j] - arc[i + 1] >= gap && !skip(i, Other::Segment(j)) {
                 let d = strand_distance(points, i, Other::Segment(j), reach).0;
                 if d < best.0 {
                     best = (d, i, Other::Segment(j));
@@ -277,7 +323,7 @@ fn closest_strands(points: &[Vector3<f64>], arc: &[f64], gap: f64) -> (usize, Ot
         }
         for (ray, base) in [(Other::BottomRay, 0.0), (Other::TopRay, 1.0)] {
             let mid = 0.5 * (arc[i] + arc[i + 1]);
-            if (mid - base).abs() >= gap {
+            if (mid - base).abs() >= gap && !skip(i, ray) {
                 let d = strand_distance(points, i, ray, reach).0;
                 if d < best.0 {
                     best = (d, i, ray);
@@ -438,21 +484,33 @@ impl Walk<'_, '_> {
         Ok((!knotted).then_some(Failure::Knot))
     }
 
-    /// The condition behind a failure found between the good site `good` and
-    /// the failing site `bad`.
-    fn condition_of(&mut self, failure: Failure, good: &Site, bad: &Site) -> Result<Condition> {
+    /// The condition behind a failure at the site `bad`, just past a corner
+    /// (or the first boundary). A crossing's strands are those closest there,
+    /// other than the crossing the walk is `on`; its sign is taken at
+    /// `reference`, a good site clearly away from the corner (at the corner
+    /// itself both crossings are in contact).
+    fn condition_of(
+        &mut self,
+        failure: Failure,
+        reference: &Site,
+        bad: &Site,
+        except: &[Strands],
+    ) -> Result<Condition> {
         Ok(match failure {
             Failure::Wall => Condition::Wall,
             Failure::Stability => Condition::Stability,
             Failure::Knot => {
                 let (points, arc) = bad.point.state.centreline();
-                let (first, other) = closest_strands(&points, &arc, self.measure.self_distance_gap);
+                let (first, other) =
+                    closest_strands(&points, &arc, self.measure.self_distance_gap, except);
                 let mut c = Condition::Crossing(Strands {
                     first,
                     other,
                     sign: 1.0,
+                    segments: points.len() - 1,
                 });
-                let v = self.value(&mut c, good)?;
+                let mut probe = c;
+                let v = self.value(&mut probe, reference)?;
                 if let Condition::Crossing(s) = &mut c {
                     s.sign = if v < 0.0 { -1.0 } else { 1.0 };
                 }
@@ -496,9 +554,10 @@ impl Walk<'_, '_> {
             let target = root + offset;
             let next = self.settle(&site, along(p, normal, target))?;
             let gn = self.value(c, &next)?;
-            // secant update, unless the points are too close for the
-            // condition's accuracy (then the chord's slope is kept)
-            if gn != g && (target - s).abs() > 1e3 * CORRECTOR_TOL {
+            // secant update, unless the points are too close for the lowest
+            // eigenvalue's accuracy (then the chord's slope is kept)
+            let resolvable = offset == 0.0 || (target - s).abs() > 1e3 * CORRECTOR_TOL;
+            if gn != g && target != s && resolvable {
                 slope = (gn - g) / (target - s);
             }
             (s, g, site, last_root) = (target, gn, next, root);
@@ -623,6 +682,7 @@ fn walk_around(
             Some(f) => break (s, f),
         }
     };
+    let reference = good.clone();
     let (mut lo, mut hi, failure) = (good, bad.0, bad.1);
     let tol = if failure == Failure::Stability {
         STABILITY_TOL
@@ -636,13 +696,15 @@ fn walk_around(
             Some(_) => hi = mid,
         }
     }
-    let mut c = walk.condition_of(failure, &lo, &hi)?;
+    let mut c = walk.condition_of(failure, &reference, &hi, &[])?;
     let gradient = walk.gradient(&mut c, &lo)?;
     let (first, first_kind) = (lo.on, c.failure());
     let mut at = Step { site: lo, gradient };
     pieces.push((c, vec![(first, unit(at.gradient)[1])]));
     let mut sigma = FIRST_STEP;
     let mut count = 1;
+    let mut stuck = 0;
+    let mut tried: Vec<Strands> = Vec::new();
     loop {
         if count >= MAX_POINTS {
             bail!("boundary walk: {MAX_POINTS} points without closing");
@@ -754,10 +816,30 @@ fn walk_around(
                         }
                     }
                 }
+                // a corner right at the previous one: the crossing taken there
+                // made no progress (several strands in contact at a tip), so
+                // the next closest strands are tried
+                if b < 1e-6 {
+                    stuck += 1;
+                } else {
+                    stuck = 0;
+                    tried.clear();
+                }
+                if let Condition::Crossing(s) = c {
+                    tried.push(s);
+                }
+                if stuck > 12 {
+                    bail!(
+                        "boundary walk stuck at a corner of {} at ({:.5}, {:.5})",
+                        c.describe(),
+                        good.on[0],
+                        good.on[1]
+                    );
+                }
                 let corner = good.on;
                 let old = unit(walk.gradient(&mut c, &good)?)[1];
                 pieces.last_mut().unwrap().1.push((corner, old));
-                c = walk.condition_of(failure, &good, &bad)?;
+                c = walk.condition_of(failure, &at.site, &bad, &tried)?;
                 let gradient = walk.gradient(&mut c, &good)?;
                 pieces.push((c, vec![(corner, unit(gradient)[1])]));
                 count += 1;
@@ -774,15 +856,10 @@ fn walk_around(
 
 /// Two crossing conditions of the same strands, up to a few segments.
 fn same_crossing(a: &Condition, b: &Condition) -> bool {
-    let (Condition::Crossing(a), Condition::Crossing(b)) = (a, b) else {
-        return false;
-    };
-    let near = |x: usize, y: usize| x.abs_diff(y) <= 3;
-    near(a.first, b.first)
-        && match (a.other, b.other) {
-            (Other::Segment(i), Other::Segment(j)) => near(i, j),
-            (x, y) => x == y,
-        }
+    match (a, b) {
+        (Condition::Crossing(a), Condition::Crossing(b)) => a.near(b.first, b.other),
+        _ => false,
+    }
 }
 
 /// The paper's name of a piece: walls are W1 where the good region lies
@@ -901,19 +978,10 @@ pub fn grid_check(traced: &Traced, lines: &[Line]) -> Option<GridCheck> {
     if !traced.closed {
         return None;
     }
-    let all: Vec<[f64; 2]> = traced
-        .pieces
-        .iter()
-        .flat_map(|p| p.points.clone())
-        .collect();
     let (mut ends, mut worst, mut other) = (0, 0.0f64, Vec::new());
     for l in lines {
         let v = l.value;
-        let cuts: Vec<f64> = all
-            .windows(2)
-            .filter(|w| (w[0][0] - v) * (w[1][0] - v) < 0.0)
-            .map(|w| w[0][1] + (v - w[0][0]) / (w[1][0] - w[0][0]) * (w[1][1] - w[0][1]))
-            .collect();
+        let cuts = traced.cuts(v);
         let grid: Vec<f64> = l.intervals.iter().flat_map(|i| [i.lo, i.hi]).collect();
         if cuts.len() != grid.len() {
             other.push(v);

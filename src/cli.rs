@@ -635,8 +635,18 @@ fn map_command(
     for (k, v) in &map3.bounding_box {
         writeln!(out, "  good knots for {k} in [{:.5}, {:.5}]", v[0], v[1])?;
     }
-    for (v, a) in map3.slice_values.iter().zip(&map3.slice_areas) {
-        writeln!(out, "  {} = {v}: good area {a:.6}", map3.slice_parameter)?;
+    for ((v, a), t) in map3
+        .slice_values
+        .iter()
+        .zip(&map3.slice_areas)
+        .zip(&map3.traced_areas)
+    {
+        writeln!(
+            out,
+            "  {} = {v}: good area {a:.6}, traced {}",
+            map3.slice_parameter,
+            t.map_or("—".to_string(), |t| format!("{t:.6}"))
+        )?;
     }
     for p in crate::plot::island_slices(&json.with_extension(""), &map3)? {
         writeln!(out, "plot written to {}", p.display())?;

@@ -160,6 +160,9 @@ pub struct SliceSpec {
     /// φ/2π of each slice's starting equilibrium (default: the scene's).
     #[serde(default)]
     pub start_phi_over_2pi: Option<Vec<f64>>,
+    /// Each slice's good knot to start the boundary walk from (`map.trace_from`).
+    #[serde(default)]
+    pub trace_from: Option<Vec<[f64; 2]>>,
 }
 
 fn default_slicing() -> Parameter {
@@ -179,6 +182,9 @@ impl SliceSpec {
         }
         if let Some(m) = s.map.as_mut() {
             m.slices = None;
+            if let Some(t) = &self.trace_from {
+                m.trace_from = Some(t[k]);
+            }
         }
         s
     }
@@ -202,6 +208,9 @@ pub struct Map3 {
     pub good_volume: f64,
     /// Bounding box of the good region over all slices.
     pub bounding_box: BTreeMap<String, [f64; 2]>,
+    /// Area enclosed by each slice's traced boundary (None: not closed).
+    #[serde(default)]
+    pub traced_areas: Vec<Option<f64>>,
     /// The slices' maps.
     pub slices: Vec<Map>,
 }
@@ -240,6 +249,10 @@ pub fn assemble_3d(scene: &str, spec: &SliceSpec, slices: Vec<Map>) -> Map3 {
         slice_areas: areas,
         good_volume: volume,
         bounding_box,
+        traced_areas: slices
+            .iter()
+            .map(|m| m.traced.as_ref().and_then(|t| t.area))
+            .collect(),
         slices,
     }
 }

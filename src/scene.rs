@@ -650,6 +650,14 @@ impl Scene {
                         "needs one value per slice",
                     ));
                 }
+                if let Some(p) = &sl.trace_from
+                    && p.len() != sl.values.len()
+                {
+                    return Err(invalid(
+                        "map.slices.trace_from",
+                        "needs one point per slice",
+                    ));
+                }
             }
         }
         if let Some(c) = &self.contact {

@@ -446,8 +446,9 @@ fn island_table_of(scenes: &Path, name: &str) -> Result<String> {
         std::env::temp_dir().join(format!("knotrod-validate-island-{}", std::process::id()));
     let indices: Vec<usize> = (0..spec.lines).collect();
     let lines = crate::map::compute_lines(&scene, &spec, &indices, None, &cache, &|_| {})?;
+    let traced = crate::boundary::trace_cached(&scene, &spec, None, &cache, &|_, _| {})?;
     let _ = std::fs::remove_dir_all(&cache);
-    let map = crate::map::assemble(name, &spec, cont.range, lines, None);
+    let map = crate::map::assemble(name, &spec, cont.range, lines, Some(traced));
     let mut s = String::new();
     writeln!(
         s,
@@ -484,12 +485,149 @@ fn island_table_of(scenes: &Path, name: &str) -> Result<String> {
         bb.get("phi_over_2pi").map_or(f64::NAN, |v| v[0]),
         bb.get("phi_over_2pi").map_or(f64::NAN, |v| v[1]),
         map.good_area,
-        map.boundaries
+        map.grid_boundaries
             .keys()
             .cloned()
             .collect::<Vec<_>>()
             .join(", ")
     )?;
+    if let Some(t) = &map.traced {
+        s += &traced_table(t)?;
+        s += &refined_ends(&scene, &spec, &map, t)?;
+    }
+    Ok(s)
+}
+
+/// Grid ends more than 5e-4 from the traced loop, recomputed on their line
+/// with a continuation step 20 times finer: a coarse step can jump over a
+/// thin sliver of another class.
+fn refined_ends(
+    scene: &Scene,
+    spec: &crate::map::MapSpec,
+    map: &crate::map::Map,
+    t: &crate::boundary::Traced,
+) -> Result<String> {
+    let mut s = String::new();
+    let mut fine = scene.clone();
+    let c = fine
+        .continuation
+        .as_mut()
+        .context("the map has a [continuation]")?;
+    let step = c.max_step.unwrap_or(0.01) / 20.0;
+    c.max_step = Some(step);
+    for l in &map.lines {
+        let cuts = t.cuts(l.value);
+        let nearest = |x: f64| {
+            cuts.iter()
+                .copied()
+                .min_by(|a, b| (a - x).abs().total_cmp(&(b - x).abs()))
+        };
+        let far: Vec<(f64, f64)> = l
+            .intervals
+            .iter()
+            .flat_map(|i| [i.lo, i.hi])
+            .filter_map(|e| nearest(e).map(|c| (e, c)))
+            .filter(|(e, c)| (e - c).abs() > 5e-4)
+            .collect();
+        if far.is_empty() {
+            continue;
+        }
+        if s.is_empty() {
+            writeln!(
+                s,
+                "\nGrid ends more than 5e-4 from the loop, recomputed with a continuation step of {step} instead of {}:\n",
+                step * 20.0
+            )?;
+            writeln!(
+                s,
+                "| z* | grid end | refined line's nearest end | traced loop |"
+            )?;
+            writeln!(s, "|---|---|---|---|")?;
+        }
+        let refined = crate::map::line(&fine, spec, l.index, None);
+        let ends: Vec<(f64, String)> = refined
+            .intervals
+            .iter()
+            .flat_map(|i| [(i.lo, i.lo_label.clone()), (i.hi, i.hi_label.clone())])
+            .collect();
+        for (e, loop_end) in far {
+            let r = ends
+                .iter()
+                .min_by(|a, b| (a.0 - loop_end).abs().total_cmp(&(b.0 - loop_end).abs()));
+            writeln!(
+                s,
+                "| {:.3} | {:.5} | {} | {:.5} |",
+                l.value,
+                e,
+                r.map_or("—".to_string(), |r| format!("{:.5} ({})", r.0, r.1)),
+                loop_end
+            )?;
+        }
+    }
+    Ok(s)
+}
+
+/// The boundary walked by two-parameter continuation, against the grid.
+fn traced_table(t: &crate::boundary::Traced) -> Result<String> {
+    let mut s = String::new();
+    writeln!(
+        s,
+        "\nThe boundary traced directly (two-parameter continuation of each condition, the good region on the left, turning at each corner onto the condition that fails there): {} points, {} equilibria solved, {}.\n",
+        t.points,
+        t.equilibria,
+        if t.closed {
+            "the walk closes on its start".to_string()
+        } else {
+            format!("open: {}", t.stopped.as_deref().unwrap_or("?"))
+        }
+    )?;
+    writeln!(
+        s,
+        "| curve | condition | from (z*, φ/2π) | to (z*, φ/2π) | points |"
+    )?;
+    writeln!(s, "|---|---|---|---|---|")?;
+    for p in &t.pieces {
+        let (a, b) = (p.points[0], p.points[p.points.len() - 1]);
+        writeln!(
+            s,
+            "| {} | {} | ({:.4}, {:.4}) | ({:.4}, {:.4}) | {} |",
+            p.label,
+            p.condition,
+            a[0],
+            a[1],
+            b[0],
+            b[1],
+            p.points.len()
+        )?;
+    }
+    let bb = &t.bounding_box;
+    let range = |k: &str| bb.get(k).copied().unwrap_or([f64::NAN; 2]);
+    writeln!(
+        s,
+        "\nTraced extent: z* in [{:.4}, {:.4}], φ/2π in [{:.4}, {:.4}]; enclosed area {}.",
+        range("z_star")[0],
+        range("z_star")[1],
+        range("phi_over_2pi")[0],
+        range("phi_over_2pi")[1],
+        t.area.map_or("—".to_string(), |a| format!("{a:.5}"))
+    )?;
+    if let Some(g) = &t.grid_check {
+        writeln!(
+            s,
+            "Check against the grid: {} interval ends of the lines the loop spans lie within {:.1e} in φ/2π of the loop's crossings of those lines (chords of the traced polyline against bisected events); lines where the loop and the grid count different ends: {}.",
+            g.ends,
+            g.max_phi_deviation,
+            if g.lines_with_other_count.is_empty() {
+                "none".to_string()
+            } else {
+                g.lines_with_other_count
+                    .iter()
+                    .map(|v| format!("{v:.3}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            }
+        )?;
+    }
     Ok(s)
 }
 
