@@ -432,10 +432,12 @@ fn figure_3_table(d: &Scene) -> Result<String> {
 }
 
 fn island_table(scenes: &Path) -> Result<String> {
-    island_table_of(scenes, "fig7_island_kirchhoff")
+    island_table_of(scenes, "fig7_island_kirchhoff", &["S", "W1", "W2", "X"])
 }
 
-fn island_table_of(scenes: &Path, name: &str) -> Result<String> {
+/// A map's table, with its traced boundary compared with the curves the
+/// paper names (`paper`).
+fn island_table_of(scenes: &Path, name: &str, paper: &[&str]) -> Result<String> {
     let scene = Scene::load(&scenes.join(format!("{name}.toml")))?;
     let spec = scene.map.clone().context("fig7 scene has no [map]")?;
     let cont = scene
@@ -493,6 +495,21 @@ fn island_table_of(scenes: &Path, name: &str) -> Result<String> {
     )?;
     if let Some(t) = &map.traced {
         s += &traced_table(t)?;
+        let mut ours: Vec<&str> = t.pieces.iter().map(|p| p.label.as_str()).collect();
+        let order = ours.join(", ");
+        ours.sort();
+        let mut theirs = paper.to_vec();
+        theirs.sort();
+        writeln!(
+            s,
+            "Curves in walk order: {order}; {} the paper's ({}).",
+            if ours == theirs {
+                "exactly"
+            } else {
+                "not the same as"
+            },
+            paper.join(", ")
+        )?;
         s += &refined_ends(&scene, &spec, &map, t)?;
     }
     Ok(s)
@@ -835,9 +852,14 @@ fn map3_table(scenes: &Path) -> Result<String> {
             std::env::temp_dir().join(format!("knotrod-validate-fig9-{}-{k}", std::process::id()));
         let idx: Vec<usize> = (0..sspec.lines).collect();
         let lines = crate::map::compute_lines(&slice, &sspec, &idx, None, &cache, &|_| {})?;
+        let traced = crate::boundary::trace_cached(&slice, &sspec, None, &cache, &|_, _| {})?;
         let _ = std::fs::remove_dir_all(&cache);
         maps.push(crate::map::assemble(
-            "fig9", &sspec, cont.range, lines, None,
+            "fig9",
+            &sspec,
+            cont.range,
+            lines,
+            Some(traced),
         ));
     }
     let m3 = crate::map::assemble_3d("fig9_strip_3d", &slices, maps);
@@ -849,20 +871,36 @@ fn map3_table(scenes: &Path) -> Result<String> {
     )?;
     writeln!(
         s,
-        "| δ | good area | z* range | φ/2π range |\n|---|---|---|---|"
+        "| δ | good area (grid) | z* range | φ/2π range | traced boundary: area, z* range, φ/2π range | largest φ/2π gap to the grid's ends |\n|---|---|---|---|---|---|"
     )?;
     for (m, v) in m3.slices.iter().zip(&m3.slice_values) {
-        let r = |k: &str| {
-            m.bounding_box
-                .get(k)
+        let r = |b: &std::collections::BTreeMap<String, [f64; 2]>, k: &str| {
+            b.get(k)
                 .map_or("—".to_string(), |b| format!("[{:.3}, {:.3}]", b[0], b[1]))
         };
+        let traced = match &m.traced {
+            Some(t) if t.closed => format!(
+                "{:.5}, {}, {}",
+                t.area.unwrap_or(f64::NAN),
+                r(&t.bounding_box, "z_star"),
+                r(&t.bounding_box, "phi_over_2pi")
+            ),
+            Some(t) => format!("open: {}", t.stopped.as_deref().unwrap_or("?")),
+            None => "—".to_string(),
+        };
+        let gap = m
+            .traced
+            .as_ref()
+            .and_then(|t| t.grid_check.as_ref())
+            .map_or("—".to_string(), |g| {
+                format!("{:.1e} ({} ends)", g.max_phi_deviation, g.ends)
+            });
         writeln!(
             s,
-            "| {v} | {:.5} | {} | {} |",
+            "| {v} | {:.5} | {} | {} | {traced} | {gap} |",
             m.good_area,
-            r("z_star"),
-            r("phi_over_2pi")
+            r(&m.bounding_box, "z_star"),
+            r(&m.bounding_box, "phi_over_2pi")
         )?;
     }
     let b = |k: &str| {
@@ -1001,6 +1039,10 @@ pub fn report(scenes: &Path) -> Result<String> {
     s += &island_table(scenes)?;
     writeln!(
         s,
+        "\nThe paper's island is bounded by the four curves S, W1, W2 and X (compare the traced curves above). The two walls are one condition (the flip maps z to z* − z, so a symmetric knot touches both at once) and one curve round the island's lowest z*, named W1 and W2 on its two sides. S is the pitchfork of the flip-symmetric family (lowest eigenvalue zero). Where a grid end differs from the loop by more than the chords' error, the line's coarse continuation step jumped over a sliver of unwalled states between W2 and X; the refined line (table above) finds the traced W2."
+    )?;
+    writeln!(
+        s,
         "\n## Quasi-static loading: a buckled strip-like rod twisted until it snaps\n"
     )?;
     writeln!(
@@ -1025,10 +1067,10 @@ pub fn report(scenes: &Path) -> Result<String> {
         s,
         "\n## Figure 7-right: the island of good knots (elastic strip, δ = 0.05)\n"
     )?;
-    s += &island_table_of(scenes, "fig7_island_strip")?;
+    s += &island_table_of(scenes, "fig7_island_strip", &["W1", "W2", "X1", "X2"])?;
     writeln!(
         s,
-        "\nThe strip's island is larger than the rod's (area and φ range), as the paper finds. Its boundaries: W1 below-left, W2 right, the crossing curves X above. Beyond the paper's description (W1, W2, X1, X2) the computation finds a notch: an unknotted wedge bounded by two crossing curves that enters the island from above at z* ≈ 0.17 and splits the good interval of each z* above into two (see the Figure 8 table, same at N = 200)."
+        "\nThe strip's island is larger than the rod's (area and φ range), as the paper finds; the paper bounds it by W1, W2, X1 and X2 (compare the traced curves above). The grid shows a notch the paper does not describe: an unknotted wedge that enters the island from above at z* ≈ 0.17 and splits the good interval of each z* above it in two (see the Figure 8 table, same at N = 200). The walk shows what it is: not another curve but a fold of a crossing curve — the same strands (near the flip axis) pass through each other at two values of φ, and the walk follows that curve down into the notch and up again. Near the island's upper-left corner, where the two crossing curves meet, several segment pairs of nearly coincident strands are in contact at once and the walk turns through a few short corners there."
     )?;
     writeln!(s, "\n## Figure 9: good knots of the strip in (δ, z*, φ)\n")?;
     s += &map3_table(scenes)?;
