@@ -658,7 +658,7 @@ pub fn trace_island(
     let outcome = walk_around(&mut walk, start, &mut pieces, on_point);
     let stopped = outcome.err().map(|e| format!("{e:#}"));
     let closed = stopped.is_none();
-    Ok(finish(&walk, pieces, closed, stopped))
+    Ok(finish(walk.swept, walk.equilibria, pieces, closed, stopped))
 }
 
 /// Move up in φ from `start` to the first boundary, then walk around.
@@ -874,7 +874,13 @@ fn label(c: &Condition, side: f64) -> &'static str {
 }
 
 /// Name the pieces as the paper does and measure the loop.
-fn finish(walk: &Walk, pieces: Vec<Trail>, closed: bool, stopped: Option<String>) -> Traced {
+fn finish(
+    swept: Parameter,
+    equilibria: usize,
+    pieces: Vec<Trail>,
+    closed: bool,
+    stopped: Option<String>,
+) -> Traced {
     // a crossing followed across neighbouring segment pairs (a corner where
     // the knot test flickered at a sharp tip) is one curve
     let mut pieces = pieces;
@@ -954,7 +960,7 @@ fn finish(walk: &Walk, pieces: Vec<Trail>, closed: bool, stopped: Option<String>
     });
     let mut bounding_box = BTreeMap::new();
     if !all.is_empty() {
-        for (k, name) in [walk.swept.name(), "phi_over_2pi"].into_iter().enumerate() {
+        for (k, name) in [swept.name(), "phi_over_2pi"].into_iter().enumerate() {
             let lo = all.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
             let hi = all.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
             bounding_box.insert(name.to_string(), [lo, hi]);
@@ -966,7 +972,7 @@ fn finish(walk: &Walk, pieces: Vec<Trail>, closed: bool, stopped: Option<String>
         closed,
         area,
         bounding_box,
-        equilibria: walk.equilibria,
+        equilibria,
         stopped,
         grid_check: None,
     }
@@ -1003,4 +1009,88 @@ pub fn grid_check(traced: &Traced, lines: &[Line]) -> Option<GridCheck> {
         max_phi_deviation: worst,
         lines_with_other_count: other,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strand_distance_is_signed_and_changes_sign_through_the_crossing() {
+        // segment 0 along x at the origin; segment 2 along y at height h
+        let at = |h: f64| {
+            vec![
+                Vector3::new(-1.0, 0.0, 0.0),
+                Vector3::new(1.0, 0.0, 0.0),
+                Vector3::new(0.0, -1.0, h),
+                Vector3::new(0.0, 1.0, h),
+            ]
+        };
+        let (d, up) = strand_distance(&at(0.3), 0, Other::Segment(2), 10.0);
+        let (_, down) = strand_distance(&at(-0.2), 0, Other::Segment(2), 10.0);
+        assert!((d - 0.3).abs() < 1e-12 && (up - 0.3).abs() < 1e-12);
+        assert!((down + 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn strands_are_the_same_up_to_neighbours_and_the_flip_image() {
+        let s = Strands {
+            first: 22,
+            other: Other::Segment(76),
+            sign: 1.0,
+            segments: 101,
+        };
+        assert!(s.near(24, Other::Segment(74)));
+        // the flip image s ↔ 1 − s: segment i ↔ 100 − i, the pair reversed
+        assert!(s.near(24, Other::Segment(78)));
+        assert!(!s.near(12, Other::Segment(89)));
+        let r = Strands {
+            first: 10,
+            other: Other::BottomRay,
+            sign: 1.0,
+            segments: 101,
+        };
+        assert!(r.near(90, Other::TopRay));
+        assert!(!r.near(90, Other::BottomRay));
+    }
+
+    #[test]
+    fn a_wall_curve_round_the_tip_is_w1_on_one_side_and_w2_on_the_other() {
+        // a closed walk starting on the wall's upper side (good side below,
+        // W2), round the tip (W1), then a stability curve back to the start
+        let trail: Vec<Trail> = vec![
+            (
+                Condition::Wall,
+                vec![
+                    ([0.2, 0.9], -0.5),
+                    ([0.1, 0.8], -0.2),
+                    ([0.1, 0.7], 0.3),
+                    ([0.2, 0.6], 0.6),
+                ],
+            ),
+            (
+                Condition::Stability,
+                vec![([0.2, 0.6], 0.1), ([0.3, 0.8], 0.1), ([0.2, 0.9], 0.1)],
+            ),
+        ];
+        let t = finish(Parameter::ZStar, 7, trail, true, None);
+        let labels: Vec<&str> = t.pieces.iter().map(|p| p.label.as_str()).collect();
+        // the walk's first piece (W2 from the start) joins its last (W2 back to
+        // the start) only when they share a name; here S closes the loop
+        assert_eq!(labels, ["W2", "W1", "S"]);
+        assert_eq!(t.pieces[0].points, vec![[0.2, 0.9], [0.1, 0.8], [0.1, 0.7]]);
+        assert_eq!(t.bounding_box["z_star"], [0.1, 0.3]);
+        // shoelace area of the polygon (0.2,0.9) (0.1,0.8) (0.1,0.7) (0.2,0.6) (0.3,0.8)
+        assert!((t.area.unwrap() - 0.035).abs() < 1e-12, "{:?}", t.area);
+        assert_eq!(t.equilibria, 7);
+    }
+
+    #[test]
+    fn the_good_side_lies_to_the_left_of_the_walk() {
+        // good side towards +z* (gradient (1, 0)): walk towards −φ
+        assert_eq!(left_tangent([1.0, 0.0]), [0.0, -1.0]);
+        let t = left_tangent([0.3, 0.4]);
+        // left of t = (−t_y, t_x) points along the gradient
+        assert!((-t[1] * 0.3 + t[0] * 0.4) > 0.0);
+    }
 }

@@ -273,3 +273,39 @@ fn twisting_a_buckled_rod_snaps_at_two_different_angles() {
         );
     }
 }
+
+/// Newton at fixed clamps (the boundary walk's equilibrium solve) moved in
+/// both parameters at once lands on the equilibrium that continuation in z*,
+/// then in φ, reaches along another path.
+#[test]
+fn settling_at_new_clamps_finds_the_equilibrium_continuation_reaches() {
+    use knotrod::equilibrium::starting_equilibrium;
+    use knotrod::model::rod::{Clamps, Parameter};
+    use knotrod::run::reach;
+    use knotrod::solve::continuation::Tracer;
+    let scene = Scene::load(std::path::Path::new("scenes/fig7_island_kirchhoff.toml")).unwrap();
+    let settings = scene.continuation.as_ref().unwrap().settings();
+    let (mut newton, start, _) = starting_equilibrium(&scene, Some(60)).unwrap();
+    let target = Clamps::new(0.125, 0.05, 0.815);
+    let by_path = {
+        let s = reach(&mut newton, start.clone(), Parameter::ZStar, 0.125, &settings).unwrap();
+        reach(&mut newton, s, Parameter::Phi, 0.815, &settings).unwrap()
+    };
+    let mut tracer = Tracer::new(&mut newton, Parameter::Phi, settings);
+    let settled = tracer.settle_at(&start, target).unwrap();
+    assert!(settled.iterations <= 6, "{} iterations", settled.iterations);
+    assert!(settled.residual <= 1e-10);
+    assert_eq!(settled.state.clamps, target);
+    assert_eq!(settled.negative_count, 0);
+    let gap = settled
+        .state
+        .nodes
+        .iter()
+        .zip(&by_path.nodes)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(gap < 1e-8, "nodes differ by {gap:.2e}");
+    // a clamp move too far for one Newton solve is refused, not jumped
+    let far = Clamps::new(0.3, 0.05, 1.1);
+    assert!(tracer.settle_at(&start, far).is_err());
+}
