@@ -130,11 +130,24 @@ pub fn run(scenes: &Path) -> Result<Report> {
         let _ = std::fs::remove_dir_all(&cache);
         Ok(())
     })?);
-    // the island's boundary walked by two-parameter continuation (one
-    // sequential computation), on the full map's range
+    // the whole Figure 7-left map as `knotrod map` computes it: the boundary
+    // walk (sequential) and the grid of 27 lines (parallel), N = 100
+    workloads.push(timed("figure_7_island_map", 100, || {
+        let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
+        let cache = std::env::temp_dir().join(format!("knotrod-bench-map-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&cache);
+        let t = crate::boundary::trace_cached(&fig7, &spec, None, &cache, &|_, _| {})?;
+        let idx: Vec<usize> = (0..spec.lines).collect();
+        crate::map::compute_lines(&fig7, &spec, &idx, None, &cache, &|_| {})?;
+        let _ = std::fs::remove_dir_all(&cache);
+        if !t.closed {
+            anyhow::bail!("boundary walk did not close: {:?}", t.stopped);
+        }
+        Ok(())
+    })?);
     workloads.push(timed("figure_7_island_boundary_walk", 100, || {
         let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
-        let t = crate::boundary::trace_island(&fig7, &spec, Some(100), &|_, _| {})?;
+        let t = crate::boundary::trace_island(&fig7, &spec, None, &|_, _| {})?;
         if !t.closed {
             anyhow::bail!("boundary walk did not close: {:?}", t.stopped);
         }

@@ -288,7 +288,14 @@ fn settling_at_new_clamps_finds_the_equilibrium_continuation_reaches() {
     let (mut newton, start, _) = starting_equilibrium(&scene, Some(60)).unwrap();
     let target = Clamps::new(0.125, 0.05, 0.815);
     let by_path = {
-        let s = reach(&mut newton, start.clone(), Parameter::ZStar, 0.125, &settings).unwrap();
+        let s = reach(
+            &mut newton,
+            start.clone(),
+            Parameter::ZStar,
+            0.125,
+            &settings,
+        )
+        .unwrap();
         reach(&mut newton, s, Parameter::Phi, 0.815, &settings).unwrap()
     };
     let mut tracer = Tracer::new(&mut newton, Parameter::Phi, settings);
