@@ -212,6 +212,9 @@ struct Site {
 const FIRST_STEP: f64 = 0.002;
 const MIN_STEP: f64 = 1e-6;
 const MAX_POINTS: usize = 4000;
+/// Most equilibria one walk may solve (a walk creeping through a tangle of
+/// tiny corners stops instead of running for hours).
+const MAX_EQUILIBRIA: usize = 100_000;
 /// Largest clamp move per Newton solve, in either coordinate.
 const SUBSTEP: f64 = 0.004;
 /// Forward-difference step of condition gradients.
@@ -706,8 +709,13 @@ fn walk_around(
     let mut stuck = 0;
     let mut tried: Vec<Strands> = Vec::new();
     loop {
-        if count >= MAX_POINTS {
-            bail!("boundary walk: {MAX_POINTS} points without closing");
+        if count >= MAX_POINTS || walk.equilibria >= MAX_EQUILIBRIA {
+            bail!(
+                "boundary walk: {count} points and {} equilibria without closing, at ({:.5}, {:.5})",
+                walk.equilibria,
+                at.site.on[0],
+                at.site.on[1]
+            );
         }
         let t = left_tangent(at.gradient);
         let normal = unit(at.gradient);
@@ -840,7 +848,17 @@ fn walk_around(
                 let old = unit(walk.gradient(&mut c, &good)?)[1];
                 pieces.last_mut().unwrap().1.push((corner, old));
                 c = walk.condition_of(failure, &at.site, &bad, &tried)?;
-                let gradient = walk.gradient(&mut c, &good)?;
+                let mut gradient = walk.gradient(&mut c, &good)?;
+                // the region is the intersection of the good sides, so the
+                // walk leaves a corner into the old condition's good side;
+                // a crossing whose sign, taken near the corner, says
+                // otherwise is oriented by this instead
+                if let Condition::Crossing(s) = &mut c
+                    && dot2(left_tangent(gradient), normal) < 0.0
+                {
+                    s.sign = -s.sign;
+                    gradient = [-gradient[0], -gradient[1]];
+                }
                 pieces.push((c, vec![(corner, unit(gradient)[1])]));
                 count += 1;
                 on_point(count, &c.describe());
