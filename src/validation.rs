@@ -903,6 +903,34 @@ fn map3_table(scenes: &Path) -> Result<String> {
             r(&m.bounding_box, "phi_over_2pi")
         )?;
     }
+    // the slice whose traced region reaches highest in z*, traced again at 2N
+    let top = m3
+        .slices
+        .iter()
+        .enumerate()
+        .filter_map(|(k, m)| {
+            let t = m.traced.as_ref().filter(|t| t.closed)?;
+            Some((k, t.bounding_box.get("z_star")?[1]))
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    if let Some((k, zmax)) = top {
+        let slice = slices.scene(&scene, k);
+        let sspec = slice.map.clone().unwrap();
+        let n = 2 * scene.model.segments as usize;
+        let t = crate::boundary::trace_island(&slice, &sspec, Some(n), &|_, _| {})?;
+        let fine = t
+            .bounding_box
+            .get("z_star")
+            .map_or("—".to_string(), |b| format!("{:.4}", b[1]));
+        writeln!(
+            s,
+            "\nThe traced region reaching highest, at δ = {}: largest z* {zmax:.4} at N = {}, {fine} at N = {n} (walk {}; area {}).",
+            slices.values[k],
+            scene.model.segments,
+            if t.closed { "closed" } else { "open" },
+            t.area.map_or("—".to_string(), |a| format!("{a:.5}"))
+        )?;
+    }
     let b = |k: &str| {
         m3.bounding_box
             .get(k)
