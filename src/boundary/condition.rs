@@ -1,0 +1,210 @@
+//! The conditions that bound the good region: walls, crossings of two
+//! strands (with their flip images), stability.
+
+use crate::geometry::distance::segment_distance;
+use nalgebra::Vector3;
+
+/// The other strand of a crossing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Other {
+    /// Another segment of the centreline.
+    Segment(usize),
+    /// The ray continuing the s = 0 clamp (along −e3).
+    BottomRay,
+    /// The ray continuing the s = 1 clamp (along +e3).
+    TopRay,
+}
+
+/// Two strands whose passage through each other changes the knot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Strands {
+    /// Segment of the centreline (segment k joins centreline points k, k+1).
+    pub first: usize,
+    /// The strand it crosses.
+    pub other: Other,
+    /// Orientation: +1 or −1, so that the good side is positive.
+    pub sign: f64,
+    /// Number of centreline segments (for the flip image of the strands).
+    pub segments: usize,
+}
+
+/// A boundary condition: zero on the curve, positive on the good side.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Condition {
+    /// Walls: min(lowest interior node height, z* − highest).
+    Wall,
+    /// Signed distance of two crossing strands.
+    Crossing(Strands),
+    /// Lowest eigenvalue of the Hessian.
+    Stability,
+}
+
+/// The property of a good knot that fails first at a state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Failure {
+    Wall,
+    Knot,
+    Stability,
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Failure::Wall => "it is not between the walls",
+            Failure::Knot => "its ray closure is not a trefoil",
+            Failure::Stability => "it is unstable",
+        })
+    }
+}
+
+impl Condition {
+    pub(super) fn failure(&self) -> Failure {
+        match self {
+            Condition::Wall => Failure::Wall,
+            Condition::Crossing(_) => Failure::Knot,
+            Condition::Stability => Failure::Stability,
+        }
+    }
+
+    /// Description, as in the JSON summary.
+    pub fn describe(&self) -> String {
+        match self {
+            Condition::Wall => "wall".into(),
+            Condition::Crossing(s) => match s.other {
+                Other::Segment(j) => format!("crossing of segments {} and {j}", s.first),
+                Other::BottomRay => format!("segment {} crossing the bottom ray", s.first),
+                Other::TopRay => format!("segment {} crossing the top ray", s.first),
+            },
+            Condition::Stability => "lowest eigenvalue zero".into(),
+        }
+    }
+}
+
+/// Signed distance of segment i from the other strand (positive along
+/// tᵢ × t_other) and the unsigned distance.
+pub(super) fn strand_distance(
+    points: &[Vector3<f64>],
+    i: usize,
+    other: Other,
+    reach: f64,
+) -> (f64, f64) {
+    let (a0, a1) = (points[i], points[i + 1]);
+    let last = *points.last().unwrap();
+    let (b0, b1) = match other {
+        Other::Segment(j) => (points[j], points[j + 1]),
+        Other::BottomRay => (points[0], points[0] - reach * Vector3::z()),
+        Other::TopRay => (last, last + reach * Vector3::z()),
+    };
+    let (d, ta, tb) = segment_distance(&a0, &a1, &b0, &b1);
+    let pa = a0 + ta * (a1 - a0);
+    let pb = b0 + tb * (b1 - b0);
+    let n = (a1 - a0).cross(&(b1 - b0));
+    (d, (pb - pa).dot(&n) / n.norm().max(1e-300))
+}
+
+impl Strands {
+    /// The same strands, up to 3 segments along each, or their image by
+    /// the flip symmetry (s ↔ 1 − s, the rays swapped): a flip-symmetric
+    /// knot passes through itself at two mirror points at once, so the two
+    /// crossings are one boundary.
+    pub(super) fn near(&self, first: usize, other: Other) -> bool {
+        // strands crossing at a shallow angle are close over several pairs
+        let close = |x: usize, y: usize| x.abs_diff(y) <= 3;
+        let same = |a: usize, oa: Other, b: usize, ob: Other| {
+            close(a, b)
+                && match (oa, ob) {
+                    (Other::Segment(i), Other::Segment(j)) => close(i, j),
+                    (x, y) => x == y,
+                }
+        };
+        let m = |i: usize| (self.segments - 1).saturating_sub(i);
+        let mirror = match other {
+            Other::Segment(j) => (m(j), Other::Segment(m(first))),
+            Other::BottomRay => (m(first), Other::TopRay),
+            Other::TopRay => (m(first), Other::BottomRay),
+        };
+        same(self.first, self.other, first, other)
+            || same(self.first, self.other, mirror.0, mirror.1)
+    }
+}
+
+/// The strands nearest to passing through each other: the closest pair of
+/// segments at least `gap` apart in arc length, or a segment and a ray,
+/// other than the strands `except` (the crossings the walk is on or tried
+/// already at this corner, in contact
+/// at a corner between two crossings).
+pub(super) fn closest_strands(
+    points: &[Vector3<f64>],
+    arc: &[f64],
+    gap: f64,
+    except: &[Strands],
+) -> (usize, Other) {
+    let reach = 2.0 * crate::geometry::closure::extent(points) + 1.0;
+    let segments = points.len() - 1;
+    let skip = |i: usize, o: Other| except.iter().any(|e| e.near(i, o));
+    let mut best = (f64::INFINITY, 0, Other::TopRay);
+    for i in 0..segments {
+        for j in i + 1..segments {
+            if arc[j] - arc[i + 1] >= gap && !skip(i, Other::Segment(j)) {
+                let d = strand_distance(points, i, Other::Segment(j), reach).0;
+                if d < best.0 {
+                    best = (d, i, Other::Segment(j));
+                }
+            }
+        }
+        for (ray, base) in [(Other::BottomRay, 0.0), (Other::TopRay, 1.0)] {
+            let mid = 0.5 * (arc[i] + arc[i + 1]);
+            if (mid - base).abs() >= gap && !skip(i, ray) {
+                let d = strand_distance(points, i, ray, reach).0;
+                if d < best.0 {
+                    best = (d, i, ray);
+                }
+            }
+        }
+    }
+    (best.1, best.2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strand_distance_is_signed_and_changes_sign_through_the_crossing() {
+        // segment 0 along x at the origin; segment 2 along y at height h
+        let at = |h: f64| {
+            vec![
+                Vector3::new(-1.0, 0.0, 0.0),
+                Vector3::new(1.0, 0.0, 0.0),
+                Vector3::new(0.0, -1.0, h),
+                Vector3::new(0.0, 1.0, h),
+            ]
+        };
+        let (d, up) = strand_distance(&at(0.3), 0, Other::Segment(2), 10.0);
+        let (_, down) = strand_distance(&at(-0.2), 0, Other::Segment(2), 10.0);
+        assert!((d - 0.3).abs() < 1e-12 && (up - 0.3).abs() < 1e-12);
+        assert!((down + 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn strands_are_the_same_up_to_neighbours_and_the_flip_image() {
+        let s = Strands {
+            first: 22,
+            other: Other::Segment(76),
+            sign: 1.0,
+            segments: 101,
+        };
+        assert!(s.near(24, Other::Segment(74)));
+        // the flip image s ↔ 1 − s: segment i ↔ 100 − i, the pair reversed
+        assert!(s.near(24, Other::Segment(78)));
+        assert!(!s.near(12, Other::Segment(89)));
+        let r = Strands {
+            first: 10,
+            other: Other::BottomRay,
+            sign: 1.0,
+            segments: 101,
+        };
+        assert!(r.near(90, Other::TopRay));
+        assert!(!r.near(90, Other::BottomRay));
+    }
+}

@@ -1,0 +1,327 @@
+//! The boundary of the island of good knots traced directly in the plane of
+//! two clamp parameters (the map's swept parameter, φ/2π). Each boundary is a
+//! codimension-one condition on the equilibria, zero on the curve and
+//! positive on the good side:
+//! - a wall touched: the smaller of the lowest interior node height (z = 0)
+//!   and z* minus the highest (z = z*) — one condition, since the flip
+//!   symmetry maps z to z* − z and a symmetric knot touches both at once;
+//! - a crossing: the signed distance of the two strands (two segments, or a
+//!   segment and a clamp's ray) whose passage changes the knot;
+//! - stability: the lowest eigenvalue of the Hessian.
+//!
+//! A condition is followed by pseudo-arclength continuation of its zero set in
+//! the plane: a predictor along the curve's tangent, a corrector along its
+//! normal (secant iteration on the condition), each evaluation an equilibrium
+//! found by Newton at fixed clamps from its neighbour, so that the whole walk
+//! stays on one family of equilibria. Walking with the good region on the
+//! left, the walk turns onto the next condition at every corner where another
+//! property fails, until it closes on its start.
+
+//!
+//! `condition` defines the conditions, `walk` the continuation round the
+//! region; this module names the pieces, measures the loop and checks it
+//! against the grid.
+
+mod condition;
+mod walk;
+
+pub use condition::{Condition, Other, Strands};
+
+use crate::map::{Line, MapSpec};
+use crate::model::rod::Parameter;
+use crate::scene::Scene;
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+pub use walk::trace_island;
+
+/// A piece of the walk: its condition, and its points with the φ component
+/// of the condition's unit gradient (positive: the good side lies above).
+type Trail = (Condition, Vec<([f64; 2], f64)>);
+
+/// One piece of the traced boundary: a polyline on one condition.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Piece {
+    /// Paper-style name (W1, W2, X, X1, S, ...).
+    pub label: String,
+    /// The condition followed.
+    pub condition: String,
+    /// Points (swept parameter, φ/2π) in walk order (good region on the left).
+    pub points: Vec<[f64; 2]>,
+}
+
+/// How the traced boundary compares with the grid of one-parameter branches.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct GridCheck {
+    /// Grid interval ends compared (lines whose value the loop spans).
+    pub ends: usize,
+    /// Largest |φ/2π(grid end) − φ/2π(nearest boundary crossing of that line)|.
+    pub max_phi_deviation: f64,
+    /// Lines where the loop and the grid count different interval ends.
+    pub lines_with_other_count: Vec<f64>,
+}
+
+/// The island's boundary traced by two-parameter continuation.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Traced {
+    /// The pieces in walk order.
+    pub pieces: Vec<Piece>,
+    /// The walk came back to its start.
+    pub closed: bool,
+    /// Area enclosed (closed walks only).
+    pub area: Option<f64>,
+    /// Extent of the traced boundary: {parameter: [lo, hi], "phi_over_2pi": [lo, hi]}.
+    pub bounding_box: BTreeMap<String, [f64; 2]>,
+    /// Points on the boundary and equilibria solved for them.
+    pub points: usize,
+    /// Equilibria solved (Newton at fixed clamps).
+    pub equilibria: usize,
+    /// Why the walk stopped before closing, if it did.
+    pub stopped: Option<String>,
+    /// Comparison with the grid's good intervals.
+    #[serde(default)]
+    pub grid_check: Option<GridCheck>,
+}
+
+impl Traced {
+    /// φ/2π where the traced loop crosses the line (swept parameter = v).
+    pub fn cuts(&self, v: f64) -> Vec<f64> {
+        let all: Vec<[f64; 2]> = self.pieces.iter().flat_map(|p| p.points.clone()).collect();
+        all.windows(2)
+            .filter(|w| (w[0][0] <= v) != (w[1][0] <= v))
+            .map(|w| w[0][1] + (v - w[0][0]) / (w[1][0] - w[0][0]) * (w[1][1] - w[0][1]))
+            .collect()
+    }
+
+    /// A walk that could not start.
+    pub fn failed(why: String) -> Self {
+        Traced {
+            pieces: vec![],
+            closed: false,
+            area: None,
+            bounding_box: BTreeMap::new(),
+            points: 0,
+            equilibria: 0,
+            stopped: Some(why),
+            grid_check: None,
+        }
+    }
+}
+
+/// The traced boundary of a map, read from `cache/trace.json` when an earlier
+/// (interrupted) run wrote it, else traced and written there.
+pub fn trace_cached(
+    scene: &Scene,
+    spec: &MapSpec,
+    segments: Option<usize>,
+    cache: &std::path::Path,
+    on_point: &dyn Fn(usize, &str),
+) -> Result<Traced> {
+    std::fs::create_dir_all(cache).with_context(|| format!("creating {}", cache.display()))?;
+    let file = cache.join("trace.json");
+    if let Some(t) = std::fs::read_to_string(&file)
+        .ok()
+        .and_then(|t| serde_json::from_str::<Traced>(&t).ok())
+    {
+        return Ok(t);
+    }
+    let traced = trace_island(scene, spec, segments, on_point)
+        .unwrap_or_else(|e| Traced::failed(format!("{e:#}")));
+    let tmp = file.with_extension("json.tmp");
+    std::fs::write(&tmp, serde_json::to_vec(&traced)?)?;
+    std::fs::rename(&tmp, &file)?;
+    Ok(traced)
+}
+
+/// Two crossing conditions of the same strands, up to a few segments.
+fn same_crossing(a: &Condition, b: &Condition) -> bool {
+    match (a, b) {
+        (Condition::Crossing(a), Condition::Crossing(b)) => a.near(b.first, b.other),
+        _ => false,
+    }
+}
+
+/// The paper's name of a piece: walls are W1 where the good region lies
+/// above them in φ, W2 where it lies below.
+fn label(c: &Condition, side: f64) -> &'static str {
+    match c {
+        Condition::Wall if side >= 0.0 => "W1",
+        Condition::Wall => "W2",
+        Condition::Crossing(_) => "X",
+        Condition::Stability => "S",
+    }
+}
+
+/// Name the pieces as the paper does and measure the loop.
+pub(crate) fn finish(
+    swept: Parameter,
+    equilibria: usize,
+    pieces: Vec<Trail>,
+    closed: bool,
+    stopped: Option<String>,
+) -> Traced {
+    // a crossing followed across neighbouring segment pairs (a corner where
+    // the knot test flickered at a sharp tip) is one curve
+    let mut pieces = pieces;
+    let mut k = 1;
+    while k < pieces.len() {
+        if same_crossing(&pieces[k - 1].0, &pieces[k].0) {
+            let next = pieces.remove(k);
+            pieces[k - 1].1.extend(next.1.into_iter().skip(1));
+        } else {
+            k += 1;
+        }
+    }
+    // split the pieces where their name changes (a wall curve turning round
+    // the island's tip is W1 on one side and W2 on the other)
+    let mut named: Vec<Piece> = Vec::new();
+    for (c, points) in &pieces {
+        let mut current: Option<Piece> = None;
+        for (k, &(p, side)) in points.iter().enumerate() {
+            let name = label(c, side);
+            match current.as_mut() {
+                Some(piece) if piece.label == name || k + 1 == points.len() => piece.points.push(p),
+                Some(piece) => {
+                    piece.points.push(p);
+                    let done = current.replace(Piece {
+                        label: name.into(),
+                        condition: c.describe(),
+                        points: vec![p],
+                    });
+                    named.extend(done);
+                }
+                None => {
+                    current = Some(Piece {
+                        label: name.into(),
+                        condition: c.describe(),
+                        points: vec![p],
+                    })
+                }
+            }
+        }
+        named.extend(current);
+    }
+    // a closed walk starts inside a piece: join its two ends
+    if closed && named.len() > 1 && named[0].label == named[named.len() - 1].label {
+        let first = named.remove(0);
+        named
+            .last_mut()
+            .unwrap()
+            .points
+            .extend(first.points.into_iter().skip(1));
+    }
+    // several pieces of one name are numbered along φ (X1, X2 as in the paper)
+    let mut by_label: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+    for (k, p) in named.iter().enumerate() {
+        by_label.entry(p.label.clone()).or_default().push(k);
+    }
+    for (label, mut ks) in by_label {
+        if ks.len() < 2 {
+            continue;
+        }
+        let mean = |p: &Piece| p.points.iter().map(|x| x[1]).sum::<f64>() / p.points.len() as f64;
+        ks.sort_by(|&a, &b| mean(&named[a]).total_cmp(&mean(&named[b])));
+        for (i, k) in ks.into_iter().enumerate() {
+            named[k].label = if label == "X" {
+                format!("X{}", i + 1)
+            } else {
+                format!("{label}.{}", i + 1)
+            };
+        }
+    }
+    let all: Vec<[f64; 2]> = named.iter().flat_map(|p| p.points.clone()).collect();
+    let area = closed.then(|| {
+        0.5 * all
+            .windows(2)
+            .map(|w| w[0][0] * w[1][1] - w[1][0] * w[0][1])
+            .sum::<f64>()
+            .abs()
+    });
+    let mut bounding_box = BTreeMap::new();
+    if !all.is_empty() {
+        for (k, name) in [swept.name(), "phi_over_2pi"].into_iter().enumerate() {
+            let lo = all.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+            let hi = all.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+            bounding_box.insert(name.to_string(), [lo, hi]);
+        }
+    }
+    Traced {
+        points: all.len(),
+        pieces: named,
+        closed,
+        area,
+        bounding_box,
+        equilibria,
+        stopped,
+        grid_check: None,
+    }
+}
+
+/// Compare a closed traced loop with the grid's good intervals: each line's
+/// interval ends against the loop's crossings of that line.
+pub fn grid_check(traced: &Traced, lines: &[Line]) -> Option<GridCheck> {
+    if !traced.closed {
+        return None;
+    }
+    let (mut ends, mut worst, mut other) = (0, 0.0f64, Vec::new());
+    for l in lines {
+        let v = l.value;
+        let cuts = traced.cuts(v);
+        let grid: Vec<f64> = l.intervals.iter().flat_map(|i| [i.lo, i.hi]).collect();
+        if cuts.len() != grid.len() {
+            other.push(v);
+        }
+        if cuts.is_empty() {
+            continue;
+        }
+        for e in grid {
+            let d = cuts
+                .iter()
+                .map(|c| (c - e).abs())
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(d);
+            ends += 1;
+        }
+    }
+    Some(GridCheck {
+        ends,
+        max_phi_deviation: worst,
+        lines_with_other_count: other,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_wall_curve_round_the_tip_is_w1_on_one_side_and_w2_on_the_other() {
+        // a closed walk starting on the wall's upper side (good side below,
+        // W2), round the tip (W1), then a stability curve back to the start
+        let trail: Vec<Trail> = vec![
+            (
+                Condition::Wall,
+                vec![
+                    ([0.2, 0.9], -0.5),
+                    ([0.1, 0.8], -0.2),
+                    ([0.1, 0.7], 0.3),
+                    ([0.2, 0.6], 0.6),
+                ],
+            ),
+            (
+                Condition::Stability,
+                vec![([0.2, 0.6], 0.1), ([0.3, 0.8], 0.1), ([0.2, 0.9], 0.1)],
+            ),
+        ];
+        let t = finish(Parameter::ZStar, 7, trail, true, None);
+        let labels: Vec<&str> = t.pieces.iter().map(|p| p.label.as_str()).collect();
+        // the walk's first piece (W2 from the start) joins its last (W2 back to
+        // the start) only when they share a name; here S closes the loop
+        assert_eq!(labels, ["W2", "W1", "S"]);
+        assert_eq!(t.pieces[0].points, vec![[0.2, 0.9], [0.1, 0.8], [0.1, 0.7]]);
+        assert_eq!(t.bounding_box["z_star"], [0.1, 0.3]);
+        // shoelace area of the polygon (0.2,0.9) (0.1,0.8) (0.1,0.7) (0.2,0.6) (0.3,0.8)
+        assert!((t.area.unwrap() - 0.035).abs() < 1e-12, "{:?}", t.area);
+        assert_eq!(t.equilibria, 7);
+    }
+}
