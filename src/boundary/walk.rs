@@ -27,7 +27,7 @@ const MIN_STEP: f64 = 1e-6;
 const MAX_POINTS: usize = 4000;
 /// Most equilibria one walk may solve (a walk creeping through a tangle of
 /// tiny corners stops instead of running for hours).
-const MAX_EQUILIBRIA: usize = 100_000;
+const MAX_EQUILIBRIA: usize = 20_000;
 /// Largest clamp move per Newton solve, in either coordinate.
 const SUBSTEP: f64 = 0.004;
 /// Forward-difference step of condition gradients.
