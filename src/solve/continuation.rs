@@ -265,6 +265,42 @@ impl<'a> Tracer<'a> {
         })
     }
 
+    /// The converged point at `state`, from the linearisation just factored
+    /// there: inertia, tangent (oriented along `orient`, else with the
+    /// parameter increasing) and the Hessian for the stability analysis.
+    fn point_at(
+        &mut self,
+        state: RodState,
+        iterations: usize,
+        residual: f64,
+        orient: Option<(&[f64], f64)>,
+        correction: f64,
+    ) -> Point {
+        let negative_count = self.negative_count();
+        let (tangent_q, tangent_p) = self.tangent(orient, 1.0);
+        Point {
+            state,
+            tangent_q,
+            tangent_p,
+            negative_count,
+            iterations,
+            residual,
+            correction,
+            hessian: self.values.as_slice().into(),
+        }
+    }
+
+    /// A Newton step that moves a node by more than 0.05 (or is not finite)
+    /// is not converging to the equilibrium it started near.
+    fn runs_away(&self, dq: &[f64]) -> bool {
+        let map = self.newton.energy.map;
+        let largest = (0..self.dofs)
+            .filter(|&d| map.is_translation(d))
+            .map(|d| dq[d].abs())
+            .fold(0.0, f64::max);
+        largest > 0.05 || dq.iter().any(|v| !v.is_finite())
+    }
+
     /// The point at arclength `sigma` from `from` along its tangent direction
     /// (`direction` overrides the tangent, e.g. a null vector at a branch point).
     pub fn correct(
@@ -276,7 +312,6 @@ impl<'a> Tracer<'a> {
         let (tq, tp) = direction.unwrap_or((&from.tangent_q, from.tangent_p));
         let mut tq = tq.to_vec();
         tq.resize(self.a.len(), 0.0);
-        let map = self.newton.energy.map;
         let p_pred = self.parameter_of(&from.state) + sigma * tp;
         let mut state = from.state.clone();
         let mut next = from.state.clone();
@@ -299,21 +334,11 @@ impl<'a> Tracer<'a> {
             if (rel <= self.settings.tolerance || at_floor)
                 && c.abs() <= 1e-10 * sigma.abs().max(1e-12)
             {
-                let negative_count = self.negative_count();
+                let correction =
+                    (self.weight * self.dot_q(&offset, &offset) + (p - p_pred).powi(2)).sqrt()
+                        / sigma.abs().max(1e-300);
                 let orient = (from.tangent_q.as_slice(), from.tangent_p);
-                let (tangent_q, tangent_p) = self.tangent(Some(orient), 1.0);
-                return Ok(Point {
-                    state,
-                    tangent_q,
-                    tangent_p,
-                    negative_count,
-                    iterations: it,
-                    residual: rel,
-                    correction: (self.weight * self.dot_q(&offset, &offset) + (p - p_pred).powi(2))
-                        .sqrt()
-                        / sigma.abs().max(1e-300),
-                    hessian: self.values.as_slice().into(),
-                });
+                return Ok(self.point_at(state, it, rel, Some(orient), correction));
             }
             if it == self.settings.max_corrector_iterations {
                 break;
@@ -334,15 +359,10 @@ impl<'a> Tracer<'a> {
             for (a, b) in self.a.iter_mut().zip(&self.b) {
                 *a = -*a - dp * b;
             }
-            let dq = &self.a;
-            // a corrector that moves far is not converging to this branch
-            let largest = (0..self.dofs)
-                .filter(|&d| map.is_translation(d))
-                .map(|d| dq[d].abs())
-                .fold(0.0, f64::max);
-            if largest > 0.05 || dq.iter().any(|v| !v.is_finite()) {
+            if self.runs_away(&self.a) {
                 return Err(ContinuationError::Corrector(it + 1));
             }
+            let dq = &self.a;
             p += dp;
             self.step_into(&state, dq, self.parameter.with(&state.clamps, p), &mut next);
             std::mem::swap(&mut state, &mut next);
@@ -374,24 +394,12 @@ impl<'a> Tracer<'a> {
             end: target.end_point() - from.clamps.end_point(),
             theta: target.phi - from.clamps.phi,
         };
-        let map = self.newton.energy.map;
         for it in 0..=self.settings.max_corrector_iterations {
             crate::solve::counters::NEWTON_ITERATIONS
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let (rel, at_floor) = self.linearise(&state)?;
             if it > 0 && (rel <= self.settings.tolerance || at_floor) {
-                let negative_count = self.negative_count();
-                let (tangent_q, tangent_p) = self.tangent(None, 1.0);
-                return Ok(Point {
-                    state,
-                    tangent_q,
-                    tangent_p,
-                    negative_count,
-                    iterations: it,
-                    residual: rel,
-                    correction: 0.0,
-                    hessian: self.values.as_slice().into(),
-                });
+                return Ok(self.point_at(state, it, rel, None, 0.0));
             }
             if it == self.settings.max_corrector_iterations {
                 break;
@@ -399,22 +407,20 @@ impl<'a> Tracer<'a> {
             let mut a = std::mem::take(&mut self.a);
             a.copy_from_slice(&self.grad);
             if it == 0 {
+                // ∂_c∇E Δc into the spare workspace `b`
                 let energy = &self.newton.energy;
-                let mut fc = vec![0.0; a.len()];
+                let mut fc = std::mem::take(&mut self.b);
                 energy.gradient_parameter_derivative(&state, &velocity, &mut fc[..n]);
                 if self.kkt.is_some() {
                     energy.constraint_parameter_derivative(&self.rows, &velocity, &mut fc[n..]);
                 }
                 a.iter_mut().zip(&fc).for_each(|(x, f)| *x += f);
+                self.b = fc;
             }
             self.solver().solve_in_place(&mut a);
             a.iter_mut().for_each(|x| *x = -*x);
             self.a = a;
-            let largest = (0..n)
-                .filter(|&d| map.is_translation(d))
-                .map(|d| self.a[d].abs())
-                .fold(0.0, f64::max);
-            if largest > 0.05 || self.a.iter().any(|v| !v.is_finite()) {
+            if self.runs_away(&self.a) {
                 return Err(ContinuationError::Corrector(it + 1));
             }
             self.step_into(&state, &self.a, target, &mut next);
