@@ -1,9 +1,9 @@
 //! One equilibrium of a scene: initial shape, Newton solve, and the quantities
 //! the paper reports (clamp reactions, twist, walls, stability).
 
-use crate::geometry::closure::{extent, ray_closure};
+use crate::geometry::closure::{closure_knot, ray_closure, reach};
 use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
-use crate::geometry::knot::{KnotType, knot_type};
+use crate::geometry::knot::KnotType;
 use crate::geometry::walls::wall_clearance;
 use crate::geometry::writhe::writhe_closed;
 use crate::model::energy::{RodEnergy, vertex_strains};
@@ -297,7 +297,7 @@ impl Shape {
         let e3 = Vector3::z();
         // the knot type and ray distances need the rays only to leave the
         // curve's neighbourhood
-        let reach = 2.0 * extent(&points) + 1.0;
+        let reach = reach(&points);
         let self_approach = min_self_distance(&points, &arc, measure.self_distance_gap);
         let heights: Vec<f64> = points[1..points.len() - 1].iter().map(|p| p.z).collect();
         let wall_distance = wall_clearance(&heights, state.clamps.z_star);
@@ -350,7 +350,7 @@ impl Shape {
             }
             None => (
                 writhe_closed(&ray_closure(&points, -e3, e3, measure.ray_length)),
-                knot_type(&ray_closure(&points, -e3, e3, reach)),
+                closure_knot(&points),
             ),
         };
         Shape {

@@ -139,7 +139,7 @@ pub(super) fn closest_strands(
     gap: f64,
     except: &[Strands],
 ) -> (usize, Other) {
-    let reach = 2.0 * crate::geometry::closure::extent(points) + 1.0;
+    let reach = crate::geometry::closure::reach(points);
     let segments = points.len() - 1;
     let skip = |i: usize, o: Other| except.iter().any(|e| e.near(i, o));
     let mut best = (f64::INFINITY, 0, Other::TopRay);

@@ -16,7 +16,6 @@
 //! stays on one family of equilibria. Walking with the good region on the
 //! left, the walk turns onto the next condition at every corner where another
 //! property fails, until it closes on its start.
-
 //!
 //! `condition` defines the conditions, `walk` the continuation round the
 //! region; this module names the pieces, measures the loop and checks it
@@ -72,7 +71,7 @@ pub struct Traced {
     pub area: Option<f64>,
     /// Extent of the traced boundary: {parameter: [lo, hi], "phi_over_2pi": [lo, hi]}.
     pub bounding_box: BTreeMap<String, [f64; 2]>,
-    /// Points on the boundary and equilibria solved for them.
+    /// Points of the pieces (a corner counts in both its pieces).
     pub points: usize,
     /// Equilibria solved (Newton at fixed clamps).
     pub equilibria: usize,
@@ -84,10 +83,15 @@ pub struct Traced {
 }
 
 impl Traced {
+    /// The pieces' points joined in walk order.
+    pub fn polygon(&self) -> Vec<[f64; 2]> {
+        self.pieces.iter().flat_map(|p| p.points.clone()).collect()
+    }
+
     /// φ/2π where the traced loop crosses the line (swept parameter = v).
     pub fn cuts(&self, v: f64) -> Vec<f64> {
-        let all: Vec<[f64; 2]> = self.pieces.iter().flat_map(|p| p.points.clone()).collect();
-        all.windows(2)
+        self.polygon()
+            .windows(2)
             .filter(|w| (w[0][0] <= v) != (w[1][0] <= v))
             .map(|w| w[0][1] + (v - w[0][0]) / (w[1][0] - w[0][0]) * (w[1][1] - w[0][1]))
             .collect()
@@ -109,7 +113,8 @@ impl Traced {
 }
 
 /// The traced boundary of a map, read from `cache/trace.json` when an earlier
-/// (interrupted) run wrote it, else traced and written there.
+/// (interrupted) run of the same scene and N wrote it, else traced and
+/// written there.
 pub fn trace_cached(
     scene: &Scene,
     spec: &MapSpec,
@@ -117,20 +122,29 @@ pub fn trace_cached(
     cache: &std::path::Path,
     on_point: &dyn Fn(usize, &str),
 ) -> Result<Traced> {
+    #[derive(Serialize, Deserialize)]
+    struct Cached {
+        key: String,
+        traced: Traced,
+    }
     std::fs::create_dir_all(cache).with_context(|| format!("creating {}", cache.display()))?;
     let file = cache.join("trace.json");
-    if let Some(t) = std::fs::read_to_string(&file)
+    // a walk depends on the whole scene (model, start, map settings) and N
+    let key = serde_json::to_string(&(scene, spec, segments))?;
+    if let Some(c) = std::fs::read_to_string(&file)
         .ok()
-        .and_then(|t| serde_json::from_str::<Traced>(&t).ok())
+        .and_then(|t| serde_json::from_str::<Cached>(&t).ok())
+        && c.key == key
     {
-        return Ok(t);
+        return Ok(c.traced);
     }
     let traced = trace_island(scene, spec, segments, on_point)
         .unwrap_or_else(|e| Traced::failed(format!("{e:#}")));
     let tmp = file.with_extension("json.tmp");
-    std::fs::write(&tmp, serde_json::to_vec(&traced)?)?;
+    let cached = Cached { key, traced };
+    std::fs::write(&tmp, serde_json::to_vec(&cached)?)?;
     std::fs::rename(&tmp, &file)?;
-    Ok(traced)
+    Ok(cached.traced)
 }
 
 /// Two crossing conditions of the same strands, up to a few segments.
@@ -176,30 +190,22 @@ pub(crate) fn finish(
     // the island's tip is W1 on one side and W2 on the other)
     let mut named: Vec<Piece> = Vec::new();
     for (c, points) in &pieces {
-        let mut current: Option<Piece> = None;
-        for (k, &(p, side)) in points.iter().enumerate() {
+        let piece = |name: &str, p: [f64; 2]| Piece {
+            label: name.into(),
+            condition: c.describe(),
+            points: vec![p],
+        };
+        let mut current = piece(label(c, points[0].1), points[0].0);
+        for (k, &(p, side)) in points.iter().enumerate().skip(1) {
+            current.points.push(p);
+            // the piece's last point (a corner or the walk's start) keeps
+            // its piece's name; elsewhere a change of side starts a new one
             let name = label(c, side);
-            match current.as_mut() {
-                Some(piece) if piece.label == name || k + 1 == points.len() => piece.points.push(p),
-                Some(piece) => {
-                    piece.points.push(p);
-                    let done = current.replace(Piece {
-                        label: name.into(),
-                        condition: c.describe(),
-                        points: vec![p],
-                    });
-                    named.extend(done);
-                }
-                None => {
-                    current = Some(Piece {
-                        label: name.into(),
-                        condition: c.describe(),
-                        points: vec![p],
-                    })
-                }
+            if name != current.label && k + 1 < points.len() {
+                named.push(std::mem::replace(&mut current, piece(name, p)));
             }
         }
-        named.extend(current);
+        named.push(current);
     }
     // a closed walk starts inside a piece: join its two ends
     if closed && named.len() > 1 && named[0].label == named[named.len() - 1].label {
@@ -229,32 +235,32 @@ pub(crate) fn finish(
             };
         }
     }
-    let all: Vec<[f64; 2]> = named.iter().flat_map(|p| p.points.clone()).collect();
-    let area = closed.then(|| {
+    let mut traced = Traced {
+        points: named.iter().map(|p| p.points.len()).sum(),
+        pieces: named,
+        closed,
+        area: None,
+        bounding_box: BTreeMap::new(),
+        equilibria,
+        stopped,
+        grid_check: None,
+    };
+    let all = traced.polygon();
+    traced.area = closed.then(|| {
         0.5 * all
             .windows(2)
             .map(|w| w[0][0] * w[1][1] - w[1][0] * w[0][1])
             .sum::<f64>()
             .abs()
     });
-    let mut bounding_box = BTreeMap::new();
     if !all.is_empty() {
         for (k, name) in [swept.name(), "phi_over_2pi"].into_iter().enumerate() {
             let lo = all.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
             let hi = all.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
-            bounding_box.insert(name.to_string(), [lo, hi]);
+            traced.bounding_box.insert(name.to_string(), [lo, hi]);
         }
     }
-    Traced {
-        points: all.len(),
-        pieces: named,
-        closed,
-        area,
-        bounding_box,
-        equilibria,
-        stopped,
-        grid_check: None,
-    }
+    traced
 }
 
 /// Compare a closed traced loop with the grid's good intervals: each line's

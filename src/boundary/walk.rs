@@ -4,9 +4,10 @@
 
 use super::condition::{Condition, Failure, Other, Strands, closest_strands, strand_distance};
 use super::{Traced, Trail, finish};
-use crate::equilibrium::{Measure, Shape, starting_equilibrium};
+use crate::equilibrium::{Measure, starting_equilibrium};
+use crate::geometry::closure::closure_knot;
 use crate::map::MapSpec;
-use crate::model::rod::{Clamps, Parameter};
+use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
 use anyhow::{Context, Result, bail};
@@ -79,23 +80,28 @@ impl Walk<'_, '_> {
     /// The equilibrium at `p`, continued from the one at `from` in moves of at
     /// most `SUBSTEP` per coordinate.
     fn settle(&mut self, from: &Site, p: [f64; 2]) -> Result<Site> {
+        self.settle_from(&from.point.state, from.p, p)
+    }
+
+    /// The equilibrium at `p`, continued from the equilibrium `state` at `from`.
+    fn settle_from(&mut self, state: &RodState, from: [f64; 2], p: [f64; 2]) -> Result<Site> {
         if !(p[0].is_finite() && p[1].is_finite()) {
             bail!("boundary walk: non-finite parameters");
         }
-        let moves = ((p[0] - from.p[0]).abs().max((p[1] - from.p[1]).abs()) / SUBSTEP).ceil();
+        let moves = ((p[0] - from[0]).abs().max((p[1] - from[1]).abs()) / SUBSTEP).ceil();
         let moves = (moves as usize).max(1);
-        let mut state = from.point.state.clone();
-        let mut point = None;
+        let mut point: Option<Point> = None;
         for k in 1..=moves {
             let f = k as f64 / moves as f64;
             let q = [
-                from.p[0] + f * (p[0] - from.p[0]),
-                from.p[1] + f * (p[1] - from.p[1]),
+                from[0] + f * (p[0] - from[0]),
+                from[1] + f * (p[1] - from[1]),
             ];
             self.equilibria += 1;
+            let start = point.as_ref().map_or(state, |pt| &pt.state);
             let pt = self
                 .tracer
-                .settle_at(&state, self.clamps(q))
+                .settle_at(start, self.clamps(q))
                 .with_context(|| {
                     format!(
                         "equilibrium at {} = {:.6}, φ/2π = {:.6}",
@@ -104,7 +110,6 @@ impl Walk<'_, '_> {
                         q[1]
                     )
                 })?;
-            state = pt.state.clone();
             point = Some(pt);
         }
         Ok(Site {
@@ -125,7 +130,7 @@ impl Walk<'_, '_> {
             }
             Condition::Crossing(s) => {
                 let (points, _) = state.centreline();
-                let reach = 2.0 * crate::geometry::closure::extent(&points) + 1.0;
+                let reach = crate::geometry::closure::reach(&points);
                 let segments = points.len() - 1;
                 let near = |k: usize| k.saturating_sub(3)..(k + 4).min(segments);
                 let mut best = (f64::INFINITY, 0.0, s.first, s.other);
@@ -211,48 +216,49 @@ impl Walk<'_, '_> {
         if skip != Some(Failure::Stability) && site.point.negative_count > 0 {
             return Ok(Some(Failure::Stability));
         }
+        let trefoil = |s: &RodState| closure_knot(&s.centreline().0).determinant == 3;
         let knotted = if skip == Some(Failure::Knot) {
             let off = self.settle(site, along(site.p, normal, FD))?;
-            Shape::of(&off.point.state, &self.measure).knot.determinant == 3
+            trefoil(&off.point.state)
         } else {
-            Shape::of(state, &self.measure).knot.determinant == 3
+            trefoil(state)
         };
         Ok((!knotted).then_some(Failure::Knot))
     }
 
     /// The condition behind a failure at the site `bad`, just past a corner
     /// (or the first boundary). A crossing's strands are those closest there,
-    /// other than the crossing the walk is `on`; its sign is taken at
-    /// `reference`, a good site clearly away from the corner (at the corner
-    /// itself both crossings are in contact).
-    fn condition_of(
-        &mut self,
-        failure: Failure,
-        reference: &Site,
-        bad: &Site,
-        except: &[Strands],
-    ) -> Result<Condition> {
-        Ok(match failure {
+    /// other than those in `except` (the crossing the walk is on, and those
+    /// tried at this corner); its sign by [`Walk::orient_at`].
+    fn condition_of(&mut self, failure: Failure, bad: &Site, except: &[Strands]) -> Condition {
+        match failure {
             Failure::Wall => Condition::Wall,
             Failure::Stability => Condition::Stability,
             Failure::Knot => {
                 let (points, arc) = bad.point.state.centreline();
                 let (first, other) =
                     closest_strands(&points, &arc, self.measure.self_distance_gap, except);
-                let mut c = Condition::Crossing(Strands {
+                Condition::Crossing(Strands {
                     first,
                     other,
                     sign: 1.0,
                     segments: points.len() - 1,
-                });
-                let mut probe = c;
-                let v = self.value(&mut probe, reference)?;
-                if let Condition::Crossing(s) = &mut c {
-                    s.sign = if v < 0.0 { -1.0 } else { 1.0 };
-                }
-                c
+                })
             }
-        })
+        }
+    }
+
+    /// Orient a crossing positive on the good side: its sign at `reference`,
+    /// a good site clearly away from where the strands touch. At a corner
+    /// the walk's direction then checks it (see `walk_around`).
+    fn orient_at(&mut self, c: &mut Condition, reference: &Site) -> Result<()> {
+        if let Condition::Crossing(s) = c {
+            let mut probe = Condition::Crossing(*s);
+            if self.value(&mut probe, reference)? < 0.0 {
+                s.sign = -1.0;
+            }
+        }
+        Ok(())
     }
 
     /// The point of condition `c` on the line through `p` along `normal`
@@ -299,6 +305,28 @@ impl Walk<'_, '_> {
             (s, g, site, last_root) = (target, gn, next, root);
         }
         bail!("corrector on {} did not converge", c.describe())
+    }
+
+    /// The point of `c` a distance `s` along the tangent from the walk's
+    /// point `at`, corrected along its normal (no farther than half the step).
+    fn correct_along(
+        &mut self,
+        c: &mut Condition,
+        at: &Step,
+        s: f64,
+        sigma: f64,
+    ) -> Result<(Site, usize)> {
+        let t = left_tangent(at.gradient);
+        let slope = at.gradient[0].hypot(at.gradient[1]);
+        let p = along(at.site.p, t, s);
+        self.correct(
+            c,
+            &at.site,
+            p,
+            unit(at.gradient),
+            slope,
+            0.5 * sigma.max(1e-4),
+        )
     }
 
     fn inside(&self, p: [f64; 2]) -> bool {
@@ -353,22 +381,9 @@ pub fn trace_island(
             spec.trace_from.unwrap_or(p0)[1]
         );
     }
-    // the start's Hessian is not known yet: only its state seeds the settle
-    let start = Site {
-        p: p0,
-        on: p0,
-        point: Point {
-            state,
-            tangent_q: vec![],
-            tangent_p: 0.0,
-            negative_count: 0,
-            iterations: 0,
-            residual: 0.0,
-            correction: 0.0,
-            hessian: std::sync::Arc::from(Vec::new()),
-        },
-    };
-    let start = walk.settle(&start, p0).context("the map's start")?;
+    let start = walk
+        .settle_from(&state, p0, p0)
+        .context("the map's start")?;
     let (start, p0) = match spec.trace_from {
         Some(p) if p != p0 => {
             let s = walk
@@ -429,7 +444,8 @@ fn walk_around(
             Some(_) => hi = mid,
         }
     }
-    let mut c = walk.condition_of(failure, &reference, &hi, &[])?;
+    let mut c = walk.condition_of(failure, &hi, &[]);
+    walk.orient_at(&mut c, &reference)?;
     let gradient = walk.gradient(&mut c, &lo)?;
     let (first, first_kind) = (lo.on, c.failure());
     let mut at = Step { site: lo, gradient };
@@ -449,16 +465,8 @@ fn walk_around(
         }
         let t = left_tangent(at.gradient);
         let normal = unit(at.gradient);
-        let slope = at.gradient[0].hypot(at.gradient[1]);
         let attempt = walk
-            .correct(
-                &mut c,
-                &at.site,
-                along(at.site.p, t, sigma),
-                normal,
-                slope,
-                0.5 * sigma.max(1e-4),
-            )
+            .correct_along(&mut c, &at, sigma, sigma)
             .and_then(|(q, it)| {
                 let g = walk.gradient(&mut c, &q)?;
                 Ok((q, it, g))
@@ -531,14 +539,7 @@ fn walk_around(
                 while b - a > tol {
                     let m = 0.5 * (a + b);
                     // no equilibrium on the curve there: count it as past the corner
-                    let Ok((s, _)) = walk.correct(
-                        &mut c,
-                        &at.site,
-                        along(at.site.p, t, m),
-                        normal,
-                        slope,
-                        0.5 * sigma.max(1e-4),
-                    ) else {
+                    let Ok((s, _)) = walk.correct_along(&mut c, &at, m, sigma) else {
                         b = m;
                         continue;
                     };
@@ -577,12 +578,13 @@ fn walk_around(
                 let corner = good.on;
                 let old = unit(walk.gradient(&mut c, &good)?)[1];
                 pieces.last_mut().unwrap().1.push((corner, old));
-                c = walk.condition_of(failure, &at.site, &bad, &tried)?;
+                c = walk.condition_of(failure, &bad, &tried);
+                walk.orient_at(&mut c, &at.site)?;
                 let mut gradient = walk.gradient(&mut c, &good)?;
                 // the region is the intersection of the good sides, so the
-                // walk leaves a corner into the old condition's good side;
-                // a crossing whose sign, taken near the corner, says
-                // otherwise is oriented by this instead
+                // walk leaves a corner into the old condition's good side; a
+                // crossing whose sign at the last point says otherwise is
+                // turned round
                 if let Condition::Crossing(s) = &mut c
                     && dot2(left_tangent(gradient), normal) < 0.0
                 {

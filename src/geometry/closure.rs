@@ -41,3 +41,16 @@ pub fn extent(points: &[Vector3<f64>]) -> f64 {
         .map(|p| (p - points[0]).norm())
         .fold(0.0, f64::max)
 }
+
+/// Length of rays that leave the curve's neighbourhood: twice its extent
+/// plus the rod's length.
+pub fn reach(points: &[Vector3<f64>]) -> f64 {
+    2.0 * extent(points) + 1.0
+}
+
+/// Knot type of the closure by rays along −e3 from the first point and +e3
+/// from the last (the paper's closure of a clamped rod).
+pub fn closure_knot(points: &[Vector3<f64>]) -> crate::geometry::knot::KnotType {
+    let e3 = Vector3::z();
+    crate::geometry::knot::knot_type(&ray_closure(points, -e3, e3, reach(points)))
+}
