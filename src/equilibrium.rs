@@ -313,13 +313,7 @@ impl Shape {
             if p.state.nodes.len() != state.nodes.len() || p.knot_ambiguous {
                 return false;
             }
-            let moved = p
-                .state
-                .nodes
-                .iter()
-                .zip(&state.nodes)
-                .map(|(a, b)| (a - b).norm())
-                .fold(0.0, f64::max)
+            let moved = p.state.largest_node_distance(state)
                 + (p.state.clamps.end_point() - state.clamps.end_point()).norm();
             let clearance = [
                 self_distance,

@@ -11,17 +11,40 @@ fn knotrod(args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
-fn small_map_scene(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string("scenes/fig7_island_kirchhoff.toml")
-        .unwrap()
-        .replace("segments = 100", "segments = 40")
-        .replace("range = [0.65, 1.1]", "range = [0.74, 0.95]")
-        .replace("range = [0.04, 0.30]", "range = [0.12, 0.18]")
-        .replace("lines = 27", "lines = 4")
-        .replace("grid_columns = 91", "grid_columns = 11");
-    let p = dir.join("small_map.toml");
+/// The Figure 7-left scene with some settings replaced, written into `dir`.
+fn fig7_variant(dir: &Path, name: &str, replace: &[(&str, &str)]) -> PathBuf {
+    let mut text = std::fs::read_to_string("scenes/fig7_island_kirchhoff.toml").unwrap();
+    for (from, to) in replace {
+        assert!(text.contains(from), "the scene has no {from}");
+        text = text.replace(from, to);
+    }
+    let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
     p
+}
+
+/// Run knotrod and require success.
+fn knotrod_ok(args: &[&str]) {
+    let out = knotrod(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn small_map_scene(dir: &Path) -> PathBuf {
+    fig7_variant(
+        dir,
+        "small_map.toml",
+        &[
+            ("segments = 100", "segments = 40"),
+            ("range = [0.65, 1.1]", "range = [0.74, 0.95]"),
+            ("range = [0.04, 0.30]", "range = [0.12, 0.18]"),
+            ("lines = 27", "lines = 4"),
+            ("grid_columns = 91", "grid_columns = 11"),
+        ],
+    )
 }
 
 #[test]
@@ -31,16 +54,11 @@ fn shards_merge_to_the_single_run_bit_for_bit_and_maps_resume() {
     let scene = small_map_scene(&dir);
     let s = scene.to_str().unwrap();
     let whole = dir.join("whole.json");
-    let out = knotrod(&["map", s, "--json", whole.to_str().unwrap()]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    knotrod_ok(&["map", s, "--json", whole.to_str().unwrap()]);
     let mut parts = Vec::new();
     for i in 0..3 {
         let p = dir.join(format!("part{i}.json"));
-        let out = knotrod(&[
+        knotrod_ok(&[
             "map",
             s,
             "--shard",
@@ -48,26 +66,13 @@ fn shards_merge_to_the_single_run_bit_for_bit_and_maps_resume() {
             "--json",
             p.to_str().unwrap(),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         parts.push(p);
     }
     let merged = dir.join("merged.json");
     let mut args = vec!["merge".to_string()];
     args.extend(parts.iter().map(|p| p.to_str().unwrap().to_string()));
     args.extend(["--json".to_string(), merged.to_str().unwrap().to_string()]);
-    let out = Command::new(env!("CARGO_BIN_EXE_knotrod"))
-        .args(&args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    knotrod_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     let (a, b) = (
         std::fs::read(&whole).unwrap(),
         std::fs::read(&merged).unwrap(),
@@ -113,28 +118,25 @@ fn shards_merge_to_the_single_run_bit_for_bit_and_maps_resume() {
 fn island_boundary_traced_directly_agrees_with_the_grid() {
     let dir = std::env::temp_dir().join(format!("knotrod-trace-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string("scenes/fig7_island_kirchhoff.toml")
-        .unwrap()
-        .replace("segments = 100", "segments = 40")
-        .replace("range = [0.65, 1.1]", "range = [0.70, 1.0]")
-        .replace("max_step = 0.01", "max_step = 0.002")
-        .replace("range = [0.04, 0.30]", "range = [0.05, 0.29]")
-        .replace("lines = 27", "lines = 13")
-        .replace("grid_columns = 91", "grid_columns = 11");
-    let scene = dir.join("trace.toml");
-    std::fs::write(&scene, text).unwrap();
+    let scene = fig7_variant(
+        &dir,
+        "trace.toml",
+        &[
+            ("segments = 100", "segments = 40"),
+            ("range = [0.65, 1.1]", "range = [0.70, 1.0]"),
+            ("max_step = 0.01", "max_step = 0.002"),
+            ("range = [0.04, 0.30]", "range = [0.05, 0.29]"),
+            ("lines = 27", "lines = 13"),
+            ("grid_columns = 91", "grid_columns = 11"),
+        ],
+    );
     let json = dir.join("trace.json");
-    let out = knotrod(&[
+    knotrod_ok(&[
         "map",
         scene.to_str().unwrap(),
         "--json",
         json.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let map: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     let traced = &map["traced"];
     assert_eq!(traced["closed"], true, "{}", traced["stopped"]);

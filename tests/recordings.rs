@@ -199,12 +199,7 @@ fn a_recorded_state_restarts_the_run_exactly() {
     assert!(again["equilibria"][0]["iterations"].as_u64().unwrap() <= 1);
     let restarted: knotrod::model::rod::RodState =
         serde_json::from_value(again["equilibria"][0]["state"].clone()).unwrap();
-    let moved = restarted
-        .nodes
-        .iter()
-        .zip(&recorded.nodes)
-        .map(|(a, b)| (a - b).norm())
-        .fold(0.0, f64::max);
+    let moved = restarted.largest_node_distance(&recorded);
     assert!(moved < 1e-10, "restart moved the state by {moved}");
 }
 

@@ -167,12 +167,7 @@ fn unbendable_rod_is_the_limit_of_large_k2() {
             .minimize(&mut state, &NewtonSettings::default())
             .unwrap();
         assert!(r.converged);
-        let gap = state
-            .nodes
-            .iter()
-            .zip(&limit.nodes)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
+        let gap = state.largest_node_distance(&limit);
         gaps.push(gap);
     }
     for w in gaps.windows(2) {

@@ -396,6 +396,15 @@ impl RodState {
         [vec3(d1), vec3(d2), t]
     }
 
+    /// Largest distance between corresponding nodes of two states of one rod.
+    pub fn largest_node_distance(&self, other: &RodState) -> f64 {
+        self.nodes
+            .iter()
+            .zip(&other.nodes)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max)
+    }
+
     /// Interior node heights: (min z, max z) over nodes 1..=N (s in (0,1)).
     pub fn z_range(&self) -> (f64, f64) {
         let n = self.segments();
