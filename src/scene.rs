@@ -627,6 +627,10 @@ impl Scene {
             if m.grid_columns < 2 {
                 return Err(invalid("map.grid_columns", "must be >= 2"));
             }
+            positive("map.trace_step", m.trace_step)?;
+            for v in m.trace_from.iter().flatten() {
+                finite("map.trace_from", *v)?;
+            }
             if let Some(sl) = &m.slices {
                 if sl.values.is_empty() || sl.values.iter().any(|v| !v.is_finite()) {
                     return Err(invalid("map.slices.values", "must be finite and non-empty"));
@@ -649,6 +653,9 @@ impl Scene {
                         "map.slices.start_phi_over_2pi",
                         "needs one value per slice",
                     ));
+                }
+                for v in sl.trace_from.iter().flatten().flatten() {
+                    finite("map.slices.trace_from", *v)?;
                 }
                 if let Some(p) = &sl.trace_from
                     && p.len() != sl.values.len()

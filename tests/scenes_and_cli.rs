@@ -14,6 +14,9 @@ delta = 0.05
 phi_over_2pi = 0.3
 "#;
 
+/// A map over the GOOD scene, its settings open for more lines.
+const MAP: &str = "\n[continuation]\nparameter = \"phi\"\nrange = [0.2, 0.4]\n\n[map]\nrange = [0.8, 0.9]\nlines = 2\n";
+
 fn error_of(text: &str) -> String {
     match Scene::parse(text) {
         Ok(_) => panic!("scene accepted:\n{text}"),
@@ -24,6 +27,8 @@ fn error_of(text: &str) -> String {
 #[test]
 fn good_scene_parses() {
     let s = Scene::parse(GOOD).unwrap();
+    // the map the bad-field cases extend is itself valid
+    Scene::parse(&format!("{GOOD}{MAP}")).unwrap();
     assert_eq!(s.model.segments, 40);
     assert!((s.clamps().phi - 0.6 * std::f64::consts::PI).abs() < 1e-15);
 }
@@ -64,6 +69,11 @@ fn bad_scenes_name_the_field() {
         (
             format!("{GOOD}\n[solver]\ngradient_tol = -1.0\n"),
             "solver.gradient_tol",
+        ),
+        (format!("{GOOD}{MAP}trace_step = 0.0\n"), "map.trace_step"),
+        (
+            format!("{GOOD}{MAP}trace_from = [0.1, nan]\n"),
+            "map.trace_from",
         ),
     ];
     for (text, field) in cases {

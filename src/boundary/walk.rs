@@ -368,9 +368,6 @@ pub fn trace_island(
         max_step: spec.trace_step,
         equilibria: 0,
     };
-    if !(spec.trace_step > 0.0 && spec.trace_step.is_finite()) {
-        bail!("map.trace_step must be positive, not {}", spec.trace_step);
-    }
     let p0 = [spec.parameter.value(&base), base.phi_over_2pi()];
     if !walk.inside(spec.trace_from.unwrap_or(p0)) {
         bail!(
