@@ -5,20 +5,21 @@
 //! branch end to end at N = 200.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use knotrod::equilibrium::{Measure, Shape, analyse, solve_scene};
+use knotrod::analysis::equilibrium::{Measure, Shape, analyse};
+use knotrod::study::start::solve_scene;
 use knotrod::model::energy::RodEnergy;
 use knotrod::model::rod::Parameter;
 use knotrod::scene::Scene;
 use knotrod::solve::continuation::{ContinuationSettings, Tracer};
 use knotrod::solve::newton::Newton;
-use knotrod::solve::sparse::Ldlt;
-use knotrod::stability::lowest_eigenvalues;
+use knotrod::linalg::sparse::Ldlt;
+use knotrod::linalg::eigen::lowest_eigenvalues;
 use std::path::Path;
 
 const SIZES: [usize; 6] = [100, 200, 400, 800, 1600, 3200];
 
 /// Builds the measured closure for one N from its equilibrium.
-type Setup<'a> = &'a dyn Fn(usize, &knotrod::equilibrium::Equilibrium) -> Box<dyn FnMut()>;
+type Setup<'a> = &'a dyn Fn(usize, &knotrod::analysis::equilibrium::Equilibrium) -> Box<dyn FnMut()>;
 
 fn bench(c: &mut Criterion) {
     let d = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
@@ -114,7 +115,7 @@ fn bench(c: &mut Criterion) {
                 contact_rows: Vec::new(),
             };
             drop(tracer);
-            knotrod::equilibrium::analyse_from(
+            knotrod::analysis::equilibrium::analyse_from(
                 &mut newton,
                 &b.state,
                 &report,
@@ -133,7 +134,7 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("figure_3_branch");
     g.sample_size(10);
     g.bench_function("200", |b| {
-        b.iter(|| knotrod::run::run_scene(&fig3, Some(200), &mut |_| Ok(())).unwrap())
+        b.iter(|| knotrod::study::run::run_scene(&fig3, Some(200), &mut |_| Ok(())).unwrap())
     });
     g.finish();
 }

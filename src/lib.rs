@@ -1,23 +1,18 @@
 //! knotrod: equilibria, stability and knot diagnostics of clamped elastic rods
 //! (discrete elastic rods), after "Stable elastic knots with no self-contact".
+//!
+//! Layers, from the bottom up (each imports only those below it; see
+//! docs/design.md): [`linalg`], [`geometry`], [`model`], [`solve`],
+//! [`analysis`], [`scene`], [`study`], [`io`], [`report`], [`cli`].
+#![warn(missing_docs)]
 
-pub mod analytic;
-pub mod asymptotics;
-pub mod bench;
-pub mod boundary;
-pub mod branch;
+pub mod analysis;
 pub mod cli;
-pub mod equilibrium;
-pub mod export;
 pub mod geometry;
-pub mod loading;
-pub mod map;
+pub mod io;
+pub mod linalg;
 pub mod model;
-pub mod plot;
-pub mod record;
-pub mod run;
+pub mod report;
 pub mod scene;
 pub mod solve;
-pub mod stability;
-pub mod summary;
-pub mod validation;
+pub mod study;

@@ -1,7 +1,7 @@
 //! Analytic cases: uniform twist, Euler buckling, torsional buckling of a
 //! clamped-clamped rod, with convergence in N.
 
-use knotrod::analytic::{self, euler_buckling_load, greenhill_constant, greenhill_twisting_moment};
+use knotrod::report::analytic::{self, euler_buckling_load, greenhill_constant, greenhill_twisting_moment};
 use knotrod::model::energy::RodEnergy;
 use knotrod::model::rod::{Clamps, RodModel, RodState};
 use knotrod::solve::newton::Newton;

@@ -1,9 +1,10 @@
 //! Contact: a clamped beam pushed onto a point obstacle (beam theory), and
 //! the trefoil tied around the rays (configurations A → B → C, Figures 3-5).
 
-use knotrod::branch::Event;
-use knotrod::equilibrium::{Equilibrium, solve_scene};
-use knotrod::run::run_scene;
+use knotrod::study::branch::Event;
+use knotrod::analysis::equilibrium::Equilibrium;
+use knotrod::study::start::solve_scene;
+use knotrod::study::run::run_scene;
 use knotrod::scene::Scene;
 
 /// A straight clamped-clamped rod (z* = 1) whose midpoint is pushed sideways
@@ -210,7 +211,7 @@ fn twisted_loop_closes_on_itself_without_passing_through() {
 
 #[test]
 fn gap_hessian_matches_finite_differences() {
-    use knotrod::geometry::contact::gap_hessian;
+    use knotrod::model::contact::gap_hessian;
     use nalgebra::Vector3;
     // interior closest points, a closest point at an end, and both at ends
     let cases = [
@@ -286,8 +287,8 @@ fn trefoil_generator_is_a_trefoil_or_says_why_not() {
     };
     let scene = Scene::parse(&text(0.115)).unwrap();
     let model = scene.rod_model(None);
-    let state = knotrod::equilibrium::initial_state(&scene, &model).unwrap();
-    let shape = knotrod::equilibrium::Shape::of(&state, &knotrod::equilibrium::Measure::of(&scene));
+    let state = knotrod::study::start::initial_state(&scene, &model).unwrap();
+    let shape = knotrod::analysis::equilibrium::Shape::of(&state, &knotrod::analysis::equilibrium::Measure::of(&scene));
     assert_eq!(shape.knot.determinant, 3);
     assert!((state.twist() + shape.writhe - 3.0).abs() < 1e-9);
     let err = solve_scene(&Scene::parse(&text(0.3)).unwrap(), None).unwrap_err();

@@ -1,9 +1,9 @@
 //! Continuation and quasi-static loading: folds, jumps, hysteresis, and the
 //! paper's Figure 3 branch.
 
-use knotrod::branch::Event;
-use knotrod::equilibrium::Equilibrium;
-use knotrod::run::run_scene;
+use knotrod::study::branch::Event;
+use knotrod::analysis::equilibrium::Equilibrium;
+use knotrod::study::run::run_scene;
 use knotrod::scene::Scene;
 
 fn run(scene: &Scene) -> (Vec<Equilibrium>, Vec<Event>) {
@@ -273,9 +273,9 @@ fn twisting_a_buckled_rod_snaps_at_two_different_angles() {
 /// then in φ, reaches along another path.
 #[test]
 fn settling_at_new_clamps_finds_the_equilibrium_continuation_reaches() {
-    use knotrod::equilibrium::starting_equilibrium;
+    use knotrod::study::start::starting_equilibrium;
     use knotrod::model::rod::{Clamps, Parameter};
-    use knotrod::run::reach;
+    use knotrod::study::run::reach;
     use knotrod::solve::continuation::Tracer;
     let scene = Scene::load(std::path::Path::new("scenes/fig7_island_kirchhoff.toml")).unwrap();
     let settings = scene.continuation.as_ref().unwrap().settings();

@@ -1,7 +1,7 @@
 //! Knot diagnostics of the paper's equilibria, self-distance against brute
 //! force, and the convergence of the writhe as the closing rays grow.
 
-use knotrod::equilibrium::solve_scene;
+use knotrod::study::start::solve_scene;
 use knotrod::geometry::closure::ray_closure;
 use knotrod::geometry::distance::{min_self_distance, min_self_distance_brute};
 use knotrod::geometry::writhe::writhe_closed;
@@ -85,7 +85,7 @@ fn writhe_carried_along_a_branch_equals_the_full_writhe() {
     // Figure 3's branch at N = 100: every accepted point's writhe was carried
     // over from the previous one (Lk = n + φ/2π) unless a strand came near
     // another; recompute each from scratch and compare
-    use knotrod::equilibrium::{Measure, Shape};
+    use knotrod::analysis::equilibrium::{Measure, Shape};
     let text = std::fs::read_to_string("scenes/fig3_kirchhoff.toml").unwrap();
     let text = text.replace("segments = 200", "segments = 100");
     let text = text.split("[output]").next().unwrap();
@@ -94,7 +94,7 @@ fn writhe_carried_along_a_branch_equals_the_full_writhe() {
         c.switch_branches = false;
     }
     let mut eqs = Vec::new();
-    knotrod::run::run_scene(&scene, None, &mut |e| {
+    knotrod::study::run::run_scene(&scene, None, &mut |e| {
         eqs.push(e);
         Ok(())
     })

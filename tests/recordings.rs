@@ -2,7 +2,7 @@
 //! Foxglove's exact schemas, restartable, finalised on Ctrl-C, and read back
 //! with clear errors when damaged.
 
-use knotrod::record::{
+use knotrod::io::recording::{
     SCALARS_TOPIC, SCENE_TOPIC, STATE_TOPIC, TF_TOPIC, read_recording, read_state,
 };
 use std::path::{Path, PathBuf};

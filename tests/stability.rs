@@ -5,7 +5,7 @@ use knotrod::model::energy::RodEnergy;
 use knotrod::model::rod::{Clamps, RodModel, RodState};
 use knotrod::model::shooting::ShootingSolution;
 use knotrod::solve::newton::{Newton, NewtonSettings};
-use knotrod::stability::lowest_eigenvalues;
+use knotrod::linalg::eigen::lowest_eigenvalues;
 use nalgebra::{DMatrix, Vector3};
 
 fn dense_lowest(h: &DMatrix<f64>, mass: Option<&[f64]>) -> Vec<f64> {
@@ -46,7 +46,7 @@ fn check(energy: &RodEnergy, state: &RodState, expect_negative: bool) {
     let mut v = vec![0.0; energy.pattern.nnz()];
     energy.hessian(state, &mut g, &mut v);
     let h = energy.pattern.to_dense(&v);
-    let mut ldlt = knotrod::solve::sparse::Ldlt::new(&energy.pattern);
+    let mut ldlt = knotrod::linalg::sparse::Ldlt::new(&energy.pattern);
     let mass = energy.lumped_mass();
     for m in [None, Some(mass.as_slice())] {
         let dense = dense_lowest(&h, m);

@@ -3,15 +3,16 @@
 //! on the constraint tangent space; the double ring's stability criterion
 //! (paper eq. 2.7); Figure 8.
 
-use knotrod::branch::Event;
-use knotrod::equilibrium::{Equilibrium, starting_equilibrium};
+use knotrod::study::branch::Event;
+use knotrod::analysis::equilibrium::Equilibrium;
+use knotrod::study::start::starting_equilibrium;
 use knotrod::model::energy::RodEnergy;
 use knotrod::model::rod::{Law, RodModel, RodState};
-use knotrod::run::run_scene;
+use knotrod::study::run::run_scene;
 use knotrod::scene::Scene;
 use knotrod::solve::newton::{Newton, NewtonSettings};
-use knotrod::solve::sparse::Ldlt;
-use knotrod::stability::lowest_eigenvalues;
+use knotrod::linalg::sparse::Ldlt;
+use knotrod::linalg::eigen::lowest_eigenvalues;
 use nalgebra::DMatrix;
 
 /// The double ring (z* = δ = 0, φ = 2π) of `kind` at N segments, relaxed.
@@ -247,7 +248,7 @@ fn figure_8_strip_branches_at_n_100() {
 
 #[test]
 fn one_contact_curves_approach_the_asymptotics() {
-    use knotrod::asymptotics::{curve_i, curve_ii, one_contact_shifts};
+    use knotrod::study::asymptotics::{curve_i, curve_ii, one_contact_shifts};
     // along Δφ = 0.8 z* → 0 (β fixed): δ_I's relative error is O(z*²) (the
     // expansion is to second order), δ_II's is O(z*) (leading order only)
     let mut errors = Vec::new();
@@ -274,6 +275,6 @@ fn one_contact_curves_approach_the_asymptotics() {
 fn one_contact_curve_reaches_the_self_contacting_elastica() {
     // as δ → 0 the largest z* on the one-contact curve tends to 0.223, the end
     // distance of the self-contacting planar elastica (paper eqs. 6.19–6.20)
-    let z = knotrod::asymptotics::max_one_contact_z_star(100, 0.001, 0.002).unwrap();
+    let z = knotrod::study::asymptotics::max_one_contact_z_star(100, 0.001, 0.002).unwrap();
     assert!((z - 0.223).abs() < 0.01, "max z* = {z}");
 }

@@ -1,8 +1,7 @@
-//! Geometry of centrelines: writhe, link, knot type of the ray closure, walls,
-//! self-distance and distance to the clamps' rays.
+//! Pure geometry of curves: polylines, ray closures, distances, walls, writhe
+//! and knot type.
 
 pub mod closure;
-pub mod contact;
 pub mod distance;
 pub mod knot;
 pub mod polyline;

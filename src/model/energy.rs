@@ -10,9 +10,9 @@
 //! so these derivatives are those of the energy along the solver's own steps.
 
 use crate::model::frames::{self, Scalar, V3, lift};
-use crate::model::jet::{self, Jet3, Jet4, Jet8};
+use crate::linalg::jet::{self, Jet3, Jet4, Jet8};
 use crate::model::rod::{DofMap, Law, RodModel, RodState, tangent};
-use crate::solve::sparse::{NO_SLOT, SymmetricPattern};
+use crate::linalg::sparse::{NO_SLOT, SymmetricPattern};
 use nalgebra::Vector3;
 
 /// Which energy terms to include.

@@ -1,7 +1,7 @@
 //! Small 3-vector algebra generic over the scalar, so that the same stencil code
 //! runs on `f64` and on dual numbers (exact derivatives by forward-mode AD).
 
-pub use crate::model::jet::Scalar;
+pub use crate::linalg::jet::Scalar;
 
 /// A 3-vector of scalars.
 pub type V3<T> = [T; 3];

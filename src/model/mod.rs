@@ -1,8 +1,10 @@
-//! Rod models: discretisation, state, energies, and the continuum (shooting) ODE.
+//! Rod and strip models: discretisation and state, clamps, constitutive laws,
+//! energies and their exact derivatives, contact gaps, the trefoil start, and
+//! the continuum (shooting) ODE.
 
+pub mod contact;
 pub mod energy;
 pub mod frames;
-pub mod jet;
 pub mod rod;
 pub mod shooting;
 pub mod trefoil;

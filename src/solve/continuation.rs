@@ -10,7 +10,7 @@ use crate::model::energy::ClampVelocity;
 use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::solve::kkt::Kkt;
 use crate::solve::newton::{Newton, SolveError, residual};
-use crate::solve::sparse::Ldlt;
+use crate::linalg::sparse::Ldlt;
 use serde::{Deserialize, Serialize};
 
 /// Settings of one continuation.
@@ -327,7 +327,7 @@ impl<'a> Tracer<'a> {
         let mut offset = vec![0.0; tq.len()];
         let mut p = p_pred;
         for it in 0..=self.settings.max_corrector_iterations {
-            crate::solve::counters::NEWTON_ITERATIONS
+            crate::linalg::counters::NEWTON_ITERATIONS
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let (rel, at_floor) = self.linearise(&state)?;
             let c = self.weight * self.dot_q(&tq, &offset) + tp * (p - p_pred);
@@ -377,7 +377,7 @@ impl<'a> Tracer<'a> {
     /// the equilibrium `from`. The first step is the linearised move of the
     /// equilibrium with the clamps (H dq = -(∇E + ∂_c∇E Δc)); the result
     /// carries its tangent in the tracer's parameter. Used to follow a
-    /// condition across the plane of two parameters (`crate::boundary`).
+    /// condition across the plane of two parameters (`crate::study::boundary`).
     pub fn settle_at(
         &mut self,
         from: &RodState,
@@ -395,7 +395,7 @@ impl<'a> Tracer<'a> {
             theta: target.phi - from.clamps.phi,
         };
         for it in 0..=self.settings.max_corrector_iterations {
-            crate::solve::counters::NEWTON_ITERATIONS
+            crate::linalg::counters::NEWTON_ITERATIONS
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let (rel, at_floor) = self.linearise(&state)?;
             if it > 0 && (rel <= self.settings.tolerance || at_floor) {
@@ -472,7 +472,7 @@ impl<'a> Tracer<'a> {
         let energy = &self.newton.energy;
         self.values.resize(energy.pattern.nnz(), 0.0);
         energy.hessian(&point.state, &mut self.grad, &mut self.values);
-        let sp = crate::stability::lowest_eigenvalues(
+        let sp = crate::linalg::eigen::lowest_eigenvalues(
             &energy.pattern,
             &self.values,
             None,

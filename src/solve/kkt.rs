@@ -7,7 +7,7 @@
 //! negatives(KKT) = negatives(reduced Hessian) + number of constraints.
 
 use crate::model::energy::RodEnergy;
-use crate::solve::sparse::{Ldlt, NO_SLOT, SymmetricPattern};
+use crate::linalg::sparse::{Ldlt, NO_SLOT, SymmetricPattern};
 
 /// KKT system of one constrained rod (unknowns: free dofs, then the N
 /// multipliers of vertices 1..=N).

@@ -3,7 +3,7 @@
 
 use crate::model::energy::{GradientInfo, RodEnergy};
 use crate::model::rod::RodState;
-use crate::solve::sparse::Ldlt;
+use crate::linalg::sparse::Ldlt;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the Newton minimiser.
@@ -49,7 +49,7 @@ pub struct NewtonReport {
     pub contacts: Vec<crate::solve::sqp::ContactForce>,
     /// The contact rows behind them, with their forces (for stability).
     #[serde(skip)]
-    pub contact_rows: Vec<(crate::geometry::contact::Gap, f64)>,
+    pub contact_rows: Vec<(crate::model::contact::Gap, f64)>,
 }
 
 impl NewtonReport {
@@ -126,7 +126,7 @@ pub struct Newton {
     /// Factorisation workspace.
     pub ldlt: Ldlt,
     /// Contact with the rays, obstacles and itself (solved by SQP).
-    pub contact: Option<crate::geometry::contact::ContactModel>,
+    pub contact: Option<crate::model::contact::ContactModel>,
     grad: Vec<f64>,
     values: Vec<f64>,
     step: Vec<f64>,
@@ -153,7 +153,7 @@ impl Newton {
     /// Replace the step by a small move (largest node move 1e-3) along the
     /// lowest eigenvector of H when its eigenvalue is negative, downhill.
     fn negative_curvature_step(&mut self, map: crate::model::rod::DofMap) {
-        let Ok(sp) = crate::stability::lowest_eigenvalues(
+        let Ok(sp) = crate::linalg::eigen::lowest_eigenvalues(
             &self.energy.pattern,
             &self.values,
             None,
@@ -197,7 +197,7 @@ impl Newton {
         state: &RodState,
         iteration: usize,
     ) -> Result<(GradientInfo, f64, bool), SolveError> {
-        crate::solve::counters::NEWTON_ITERATIONS
+        crate::linalg::counters::NEWTON_ITERATIONS
             .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let info = self.energy.hessian(state, &mut self.grad, &mut self.values);
         let gnorm = norm(&self.grad);

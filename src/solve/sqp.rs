@@ -11,12 +11,12 @@
 //! Lagrangian with the new λ (no Maratos effect: full steps near the solution,
 //! quadratic convergence).
 
-use crate::geometry::contact::{ContactModel, Gap, Obstacle, gap_hessian};
+use crate::model::contact::{ContactModel, Gap, Obstacle, gap_hessian};
 use crate::model::energy::RodEnergy;
 use crate::model::rod::RodState;
 use crate::solve::kkt::Kkt;
 use crate::solve::newton::{Newton, NewtonReport, NewtonSettings, SolveError, armijo, residual};
-use crate::solve::sparse::{Ldlt, SymmetricPattern};
+use crate::linalg::sparse::{Ldlt, SymmetricPattern};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettings, DefaultSolver, IPSolver, SolverStatus,
@@ -467,7 +467,7 @@ pub fn minimize(
                 vals[s] -= shift;
             }
             shift = if shift == 0.0 {
-                let lowest = crate::stability::lowest_eigenvalues(pat, vals, None, 1, ldlt)
+                let lowest = crate::linalg::eigen::lowest_eigenvalues(pat, vals, None, 1, ldlt)
                     .ok()
                     .and_then(|sp| sp.values.first().copied())
                     .unwrap_or(-1e-8 * max_diag);

@@ -1,7 +1,7 @@
 //! The machine-readable run summary (JSON) and its human-readable print.
 
-use crate::branch::Event;
-use crate::equilibrium::Equilibrium;
+use crate::study::branch::Event;
+use crate::analysis::equilibrium::Equilibrium;
 use crate::model::rod::RodModel;
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};

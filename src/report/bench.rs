@@ -1,7 +1,7 @@
 //! `knotrod bench`: standard workloads timed with their work counts, and the
 //! growth of per-step costs with N (fitted exponents).
 
-use crate::equilibrium::{Measure, Shape};
+use crate::analysis::equilibrium::{Measure, Shape};
 use crate::geometry::closure::ray_closure;
 use crate::geometry::distance::min_self_distance;
 use crate::geometry::knot::knot_type;
@@ -9,9 +9,9 @@ use crate::geometry::writhe::writhe_closed;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::RodState;
 use crate::scene::Scene;
-use crate::solve::counters::{FACTORIZATIONS, NEWTON_ITERATIONS};
-use crate::solve::sparse::Ldlt;
-use crate::stability::lowest_eigenvalues;
+use crate::linalg::counters::{FACTORIZATIONS, NEWTON_ITERATIONS};
+use crate::linalg::sparse::Ldlt;
+use crate::linalg::eigen::lowest_eigenvalues;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -99,7 +99,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
     let fig7 = Scene::load(&scenes.join("fig7_island_kirchhoff.toml"))?;
     let mut workloads = Vec::new();
     workloads.push(timed("appendix_d_from_shooting", 200, || {
-        crate::equilibrium::solve_scene(&d, Some(200)).map(|_| ())
+        crate::study::start::solve_scene(&d, Some(200)).map(|_| ())
     })?);
     let mut main_branch = fig3.clone();
     if let Some(c) = main_branch.continuation.as_mut() {
@@ -111,10 +111,10 @@ pub fn run(scenes: &Path) -> Result<Report> {
     let mut inertia_only = main_branch.clone();
     inertia_only.stability.eigenvalues = 0;
     workloads.push(timed("figure_3_branch", 200, || {
-        crate::run::run_scene(&inertia_only, Some(200), &mut |_| Ok(())).map(|_| ())
+        crate::study::run::run_scene(&inertia_only, Some(200), &mut |_| Ok(())).map(|_| ())
     })?);
     workloads.push(timed("figure_3_branch_with_eigenvalues", 200, || {
-        crate::run::run_scene(&main_branch, Some(200), &mut |_| Ok(())).map(|_| ())
+        crate::study::run::run_scene(&main_branch, Some(200), &mut |_| Ok(())).map(|_| ())
     })?);
     let mut island = fig7.clone();
     if let Some(m) = island.map.as_mut() {
@@ -126,7 +126,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
         let cache = std::env::temp_dir().join(format!("knotrod-bench-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&cache);
         let idx: Vec<usize> = (0..spec.lines).collect();
-        crate::map::compute_lines(&island, &spec, &idx, Some(60), &cache, &|_| {})?;
+        crate::study::map::compute_lines(&island, &spec, &idx, Some(60), &cache, &|_| {})?;
         let _ = std::fs::remove_dir_all(&cache);
         Ok(())
     })?);
@@ -136,9 +136,9 @@ pub fn run(scenes: &Path) -> Result<Report> {
         let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
         let cache = std::env::temp_dir().join(format!("knotrod-bench-map-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&cache);
-        let t = crate::boundary::trace_cached(&fig7, &spec, None, &cache, &|_, _| {})?;
+        let t = crate::study::boundary::trace_cached(&fig7, &spec, None, &cache, &|_, _| {})?;
         let idx: Vec<usize> = (0..spec.lines).collect();
-        crate::map::compute_lines(&fig7, &spec, &idx, None, &cache, &|_| {})?;
+        crate::study::map::compute_lines(&fig7, &spec, &idx, None, &cache, &|_| {})?;
         let _ = std::fs::remove_dir_all(&cache);
         if !t.closed {
             anyhow::bail!("boundary walk did not close: {:?}", t.stopped);
@@ -147,7 +147,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
     })?);
     workloads.push(timed("figure_7_island_boundary_walk", 100, || {
         let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
-        let t = crate::boundary::trace_island(&fig7, &spec, None, &|_, _| {})?;
+        let t = crate::study::boundary::trace_island(&fig7, &spec, None, &|_, _| {})?;
         if !t.closed {
             anyhow::bail!("boundary walk did not close: {:?}", t.stopped);
         }
@@ -156,7 +156,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
     // per-operation costs on the Appendix D knot resampled at each N
     let mut per: BTreeMap<String, Vec<(usize, f64)>> = BTreeMap::new();
     for n in [200, 400, 800, 1600, 3200] {
-        let e = crate::equilibrium::solve_scene(&d, Some(n))?;
+        let e = crate::study::start::solve_scene(&d, Some(n))?;
         let state: RodState = e.state.clone();
         let energy = RodEnergy::new(d.rod_model(Some(n)));
         let mut g = vec![0.0; energy.map.len()];

@@ -6,7 +6,7 @@
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::solve::newton::{Newton, NewtonSettings};
-use crate::stability::lowest_eigenvalues;
+use crate::linalg::eigen::lowest_eigenvalues;
 use anyhow::{Result, ensure};
 use std::f64::consts::PI;
 

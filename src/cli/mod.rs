@@ -4,11 +4,11 @@ use crate::geometry::closure::{extent, ray_closure};
 use crate::geometry::knot::knot_type;
 use crate::geometry::polyline::read_points;
 use crate::geometry::writhe::writhe_closed;
-use crate::plot::{PlotPoint, bifurcation_diagram};
-use crate::run::run_scene;
+use crate::io::plot::{PlotPoint, bifurcation_diagram};
+use crate::study::run::run_scene;
 use crate::scene::Scene;
-use crate::summary::{Summary, print_equilibrium, print_events};
-use crate::validation;
+use crate::io::summary::{Summary, print_equilibrium, print_events};
+use crate::report::validation;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use nalgebra::Vector3;
@@ -169,14 +169,14 @@ pub fn main_with(cli: Cli) -> Result<()> {
             if no_record { None } else { Some(record) },
         ),
         Command::Info { recording } => {
-            crate::export::info(&recording, &mut std::io::stdout().lock())
+            crate::io::export::info(&recording, &mut std::io::stdout().lock())
         }
         Command::Export {
             recording,
             index,
             format,
             out,
-        } => crate::export::export(&recording, index, format, out.as_deref()),
+        } => crate::io::export::export(&recording, index, format, out.as_deref()),
         Command::Convergence { scene, segments } => convergence(&scene, &segments),
         Command::Knot {
             curve,
@@ -187,7 +187,7 @@ pub fn main_with(cli: Cli) -> Result<()> {
         Command::Plot { summary, out } => {
             let stem = out.unwrap_or_else(|| summary.with_extension(""));
             let (title, points, events) = if summary.extension().is_some_and(|e| e == "mcap") {
-                let rec = crate::record::read_recording(&summary)?;
+                let rec = crate::io::recording::read_recording(&summary)?;
                 let points: Vec<PlotPoint> = rec.scalars.iter().map(PlotPoint::from).collect();
                 let title = summary
                     .file_stem()
@@ -219,12 +219,12 @@ pub fn main_with(cli: Cli) -> Result<()> {
             segments,
         } => map_command(&scene, json, shard.as_deref(), segments),
         Command::Merge { parts, json } => {
-            let map = crate::map::merge(&parts)?;
+            let map = crate::study::map::merge(&parts)?;
             write_map(&map, &json)
         }
         Command::Bench { scenes, json } => {
-            let r = crate::bench::run(&scenes)?;
-            crate::bench::print(&r, &mut std::io::stdout().lock())?;
+            let r = crate::report::bench::run(&scenes)?;
+            crate::report::bench::print(&r, &mut std::io::stdout().lock())?;
             if let Some(p) = json {
                 std::fs::write(&p, serde_json::to_string_pretty(&r)? + "\n")
                     .with_context(|| format!("writing {}", p.display()))?;
@@ -284,7 +284,7 @@ fn run(
                     .join(format!("{}.mcap", scene.name.as_deref().unwrap_or("run")))
             });
             let text = std::fs::read_to_string(path).unwrap_or_default();
-            Some(crate::record::Recorder::create(
+            Some(crate::io::recording::Recorder::create(
                 &file,
                 &text,
                 &model,
@@ -300,7 +300,7 @@ fn run(
     );
     let mut equilibria = Vec::new();
     let result = {
-        let mut observer = |eq: crate::equilibrium::Equilibrium| -> Result<()> {
+        let mut observer = |eq: crate::analysis::equilibrium::Equilibrium| -> Result<()> {
             if let Some((w, _)) = stream.as_mut() {
                 serde_json::to_writer(&mut *w, &eq)?;
                 w.write_all(b"\n")?;
@@ -501,7 +501,7 @@ fn polynomial(c: &[i64]) -> String {
     s
 }
 
-fn write_map(map: &crate::map::Map, json: &Path) -> Result<()> {
+fn write_map(map: &crate::study::map::Map, json: &Path) -> Result<()> {
     if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }
@@ -577,7 +577,7 @@ fn write_map(map: &crate::map::Map, json: &Path) -> Result<()> {
         }
     }
     writeln!(out, "map written to {}", json.display())?;
-    for f in crate::plot::island_map(&json.with_extension(""), map)? {
+    for f in crate::io::plot::island_map(&json.with_extension(""), map)? {
         writeln!(out, "plot written to {}", f.display())?;
     }
     Ok(())
@@ -597,7 +597,7 @@ fn map_command(
     let name = scene.name.clone().unwrap_or_else(|| "map".into());
     let json = json.unwrap_or_else(|| PathBuf::from("recordings").join(format!("{name}.map.json")));
     let shard = match shard {
-        Some(s) => Some(crate::map::parse_shard(s)?),
+        Some(s) => Some(crate::study::map::parse_shard(s)?),
         None => None,
     };
     let Some(slices) = spec.slices.clone() else {
@@ -627,7 +627,7 @@ fn map_command(
     if shard.is_some() {
         return Ok(());
     }
-    let map3 = crate::map::assemble_3d(&name, &slices, maps);
+    let map3 = crate::study::map::assemble_3d(&name, &slices, maps);
     std::fs::write(&json, serde_json::to_string_pretty(&map3)? + "\n")
         .with_context(|| format!("writing {}", json.display()))?;
     let mut out = std::io::stdout().lock();
@@ -648,7 +648,7 @@ fn map_command(
             t.map_or("—".to_string(), |t| format!("{t:.6}"))
         )?;
     }
-    for p in crate::plot::island_slices(&json.with_extension(""), &map3)? {
+    for p in crate::io::plot::island_slices(&json.with_extension(""), &map3)? {
         writeln!(out, "plot written to {}", p.display())?;
     }
     writeln!(out, "3D map written to {}", json.display())?;
@@ -663,7 +663,7 @@ fn map_plane(
     json: &Path,
     shard: Option<(usize, usize)>,
     segments: Option<usize>,
-) -> Result<Option<crate::map::Map>> {
+) -> Result<Option<crate::study::map::Map>> {
     let spec = scene
         .map
         .clone()
@@ -673,7 +673,7 @@ fn map_plane(
         .as_ref()
         .context("the scene has no [continuation] section")?;
     let indices = match shard {
-        Some(sh) => crate::map::shard_lines(&spec, sh),
+        Some(sh) => crate::study::map::shard_lines(&spec, sh),
         None => (0..spec.lines).collect(),
     };
     // computed lines are kept beside the output: an interrupted map resumes
@@ -683,7 +683,7 @@ fn map_plane(
         Some((i, _)) if i != 0 => None,
         _ => {
             let spinner = indicatif::ProgressBar::new_spinner();
-            let t = crate::boundary::trace_cached(scene, &spec, segments, &cache, &|k, on| {
+            let t = crate::study::boundary::trace_cached(scene, &spec, segments, &cache, &|k, on| {
                 spinner.set_message(format!("tracing the boundary: point {k}, on {on}"));
                 spinner.tick();
             })?;
@@ -696,7 +696,7 @@ fn map_plane(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} lines, ETA {eta} — {msg}")
             .unwrap(),
     );
-    let lines = crate::map::compute_lines(scene, &spec, &indices, segments, &cache, &|l| {
+    let lines = crate::study::map::compute_lines(scene, &spec, &indices, segments, &cache, &|l| {
         progress.inc(1);
         progress.set_message(format!(
             "{} = {:.4}: {} good intervals",
@@ -708,7 +708,7 @@ fn map_plane(
     progress.finish_and_clear();
     match shard {
         Some(sh) => {
-            let part = crate::map::Partial {
+            let part = crate::study::map::Partial {
                 scene: name.to_string(),
                 spec,
                 phi_range: cont.range,
@@ -728,7 +728,7 @@ fn map_plane(
             Ok(None)
         }
         None => {
-            let map = crate::map::assemble(name, &spec, cont.range, lines, traced);
+            let map = crate::study::map::assemble(name, &spec, cont.range, lines, traced);
             write_map(&map, json)?;
             Ok(Some(map))
         }

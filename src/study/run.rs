@@ -1,9 +1,10 @@
 //! Running a scene: one equilibrium, or branches of equilibria (continuation,
 //! optionally swept over a second parameter).
 
-use crate::branch::{BranchOptions, BranchRun, Event, Observer, label_events};
-use crate::equilibrium::{Measure, analyse, starting_equilibrium};
-use crate::loading::run_loading;
+use crate::study::branch::{BranchOptions, BranchRun, Event, Observer, label_events};
+use crate::analysis::equilibrium::{Measure, analyse};
+use crate::study::start::starting_equilibrium;
+use crate::study::loading::run_loading;
 use crate::model::rod::{Parameter, RodState};
 use crate::scene::{Direction, Scene};
 use crate::solve::continuation::{ContinuationSettings, Point, Tracer};

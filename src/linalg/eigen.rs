@@ -9,7 +9,7 @@
 //! (faer's dense eigensolver for small problems). Every step is a sparse
 //! factorisation (faer LDLᵀ) or solve: O(N).
 
-use crate::solve::sparse::{Ldlt, SymmetricPattern};
+use crate::linalg::sparse::{Ldlt, SymmetricPattern};
 use dyn_stack::{MemBuffer, MemStack};
 use faer::matrix_free::LinOp;
 use faer::{Mat, MatMut, MatRef, Par};

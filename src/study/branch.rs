@@ -3,7 +3,7 @@
 //! points (S), walls touched (W), self-crossings (X) and knot changes — and the
 //! bifurcating branches followed from branch points when asked.
 
-use crate::equilibrium::{Equilibrium, Measure, Shape, analyse_from};
+use crate::analysis::equilibrium::{Equilibrium, Measure, Shape, analyse_from};
 use crate::model::rod::{Parameter, RodState};
 use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
 use crate::solve::newton::{Newton, NewtonReport};

@@ -4,8 +4,8 @@
 //! and the minimum self-distance along the branches. SVG always; PNG when a
 //! TrueType font is found for the labels.
 
-use crate::branch::Event;
-use crate::equilibrium::Equilibrium;
+use crate::study::branch::Event;
+use crate::analysis::equilibrium::Equilibrium;
 use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -64,8 +64,8 @@ impl From<&Equilibrium> for PlotPoint {
     }
 }
 
-impl From<&crate::record::Scalars> for PlotPoint {
-    fn from(e: &crate::record::Scalars) -> Self {
+impl From<&crate::io::recording::Scalars> for PlotPoint {
+    fn from(e: &crate::io::recording::Scalars) -> Self {
         PlotPoint {
             phi_over_2pi: e.phi_over_2pi,
             twist: e.twist,
@@ -297,7 +297,7 @@ pub fn bifurcation_diagram(
 
 /// The island map: classified grid as dots (colours as in the diagrams) and
 /// the boundary curves labelled, in the (φ/2π, swept parameter) plane.
-pub fn island_map(stem: &Path, map: &crate::map::Map) -> Result<Vec<std::path::PathBuf>> {
+pub fn island_map(stem: &Path, map: &crate::study::map::Map) -> Result<Vec<std::path::PathBuf>> {
     let mut written = Vec::new();
     let fonts = font_available();
     let svg = stem.with_extension("svg");
@@ -316,7 +316,7 @@ pub fn island_map(stem: &Path, map: &crate::map::Map) -> Result<Vec<std::path::P
 
 /// A 3D map as stacked slices, one panel each (SVG, and PNG when a font is
 /// available).
-pub fn island_slices(stem: &Path, map: &crate::map::Map3) -> Result<Vec<std::path::PathBuf>> {
+pub fn island_slices(stem: &Path, map: &crate::study::map::Map3) -> Result<Vec<std::path::PathBuf>> {
     let n = map.slices.len().max(1);
     let cols = n.min(4);
     let rows = n.div_ceil(cols);
@@ -345,11 +345,11 @@ pub fn island_slices(stem: &Path, map: &crate::map::Map3) -> Result<Vec<std::pat
     Ok(written)
 }
 
-fn draw_map<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, map: &crate::map::Map) -> Result<()>
+fn draw_map<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, map: &crate::study::map::Map) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
-    use crate::map::Class;
+    use crate::study::map::Class;
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plot: {e:?}");
     root.fill(&WHITE).map_err(err)?;
     let (x0, x1) = bounds(&map.grid_phi);

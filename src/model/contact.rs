@@ -5,7 +5,7 @@
 //! a unique closest pair).
 
 use crate::geometry::distance::{CurveTree, segment_distance};
-use crate::model::jet::{self, Scalar};
+use crate::linalg::jet::{self, Scalar};
 use crate::model::rod::RodState;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};

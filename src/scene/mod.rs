@@ -42,7 +42,7 @@ pub struct Scene {
     pub loading: Vec<LoadingSpec>,
     /// Parameter-space map (with `knotrod map`).
     #[serde(default)]
-    pub map: Option<crate::map::MapSpec>,
+    pub map: Option<crate::study::map::MapSpec>,
     /// Knot diagnostics settings.
     #[serde(default)]
     pub diagnostics: DiagnosticsSpec,
@@ -714,10 +714,10 @@ impl Scene {
     }
 
     /// The contact model, if the scene has a `[contact]` section.
-    pub fn contact_model(&self) -> Option<crate::geometry::contact::ContactModel> {
+    pub fn contact_model(&self) -> Option<crate::model::contact::ContactModel> {
         self.contact
             .as_ref()
-            .map(|c| crate::geometry::contact::ContactModel {
+            .map(|c| crate::model::contact::ContactModel {
                 diameter: self.model.rod_diameter,
                 rays: c.rays,
                 self_contact: c.self_contact,

@@ -4,12 +4,12 @@
 //! being a minimum the rod jumps: the jump is detected (loss of stability of
 //! the carried state, large change of shape or of link) and recorded.
 
-use crate::branch::{Event, Observer};
-use crate::equilibrium::{Measure, analyse, analyse_from};
+use crate::study::branch::{Event, Observer};
+use crate::analysis::equilibrium::{Measure, analyse, analyse_from};
 use crate::model::rod::{Clamps, RodState};
 use crate::scene::LoadingSpec;
 use crate::solve::newton::{Newton, NewtonSettings};
-use crate::stability::lowest_eigenvalues;
+use crate::linalg::eigen::lowest_eigenvalues;
 use anyhow::{Context, Result, bail};
 
 /// A step is a jump when the minimiser lands farther than this (rod lengths)
@@ -89,7 +89,7 @@ fn max_move(a: &RodState, b: &RodState) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn eq_clamps(eq: &crate::equilibrium::Equilibrium) -> Clamps {
+fn eq_clamps(eq: &crate::analysis::equilibrium::Equilibrium) -> Clamps {
     eq.state.clamps
 }
 
@@ -191,7 +191,7 @@ fn path_event(kind: &str, c: &Clamps, twist: f64, leg: usize, detail: String) ->
 }
 
 /// Link change between two equilibria beyond the clamp's own turn.
-fn link_jump(a: &crate::equilibrium::Equilibrium, b: &crate::equilibrium::Equilibrium) -> f64 {
+fn link_jump(a: &crate::analysis::equilibrium::Equilibrium, b: &crate::analysis::equilibrium::Equilibrium) -> f64 {
     b.link - a.link - (eq_clamps(b).phi - eq_clamps(a).phi) / (2.0 * std::f64::consts::PI)
 }
 

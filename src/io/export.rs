@@ -1,7 +1,7 @@
 //! Reading recordings back: `knotrod info` and `knotrod export`.
 
 use crate::cli::ExportFormat;
-use crate::record::{read_recording, read_state};
+use crate::io::recording::{read_recording, read_state};
 use anyhow::{Context, Result};
 use std::io::Write;
 use std::path::Path;
@@ -22,7 +22,7 @@ pub fn info(path: &Path, out: &mut impl Write) -> Result<()> {
         writeln!(out, "    {topic:<14} {count} messages")?;
     }
     writeln!(out, "  states: {}", rec.scalars.len())?;
-    let range = |f: fn(&crate::record::Scalars) -> f64| {
+    let range = |f: fn(&crate::io::recording::Scalars) -> f64| {
         let v: Vec<f64> = rec.scalars.iter().map(f).collect();
         (
             v.iter().copied().fold(f64::INFINITY, f64::min),

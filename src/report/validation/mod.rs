@@ -1,8 +1,9 @@
 //! The validation report: every number in docs/validation.md is computed here
 //! (`knotrod validate > docs/validation.md`), never typed by hand.
 
-use crate::analytic::{euler_buckling_load, greenhill_constant, greenhill_twisting_moment};
-use crate::equilibrium::{Equilibrium, solve_scene};
+use crate::report::analytic::{euler_buckling_load, greenhill_constant, greenhill_twisting_moment};
+use crate::analysis::equilibrium::Equilibrium;
+use crate::study::start::solve_scene;
 use crate::geometry::closure::ray_closure;
 use crate::geometry::writhe::writhe_closed;
 use crate::model::energy::RodEnergy;
@@ -10,7 +11,7 @@ use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
 use crate::scene::{InitialShape, Scene};
 use crate::solve::newton::{Newton, NewtonSettings};
-use crate::summary::relative_deviation;
+use crate::io::summary::relative_deviation;
 use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
@@ -372,7 +373,7 @@ fn writhe_table(scenes: &[&Scene]) -> Result<String> {
 }
 
 /// Events of the Figure 3 branch (main branch, φ/2π in [0.745, 0.99]) at N.
-fn figure_3_events(d: &Scene, n: usize) -> Result<Vec<crate::branch::Event>> {
+fn figure_3_events(d: &Scene, n: usize) -> Result<Vec<crate::study::branch::Event>> {
     let mut scene = d.clone();
     scene.continuation = Some(crate::scene::ContinuationSpec {
         parameter: crate::model::rod::Parameter::Phi,
@@ -384,7 +385,7 @@ fn figure_3_events(d: &Scene, n: usize) -> Result<Vec<crate::branch::Event>> {
         max_step: None,
         max_points: None,
     });
-    crate::run::run_scene(&scene, Some(n), &mut |_| Ok(()))
+    crate::study::run::run_scene(&scene, Some(n), &mut |_| Ok(()))
 }
 
 fn figure_3_table(d: &Scene) -> Result<String> {
@@ -447,10 +448,10 @@ fn island_table_of(scenes: &Path, name: &str, paper: &[&str]) -> Result<String> 
     let cache =
         std::env::temp_dir().join(format!("knotrod-validate-island-{}", std::process::id()));
     let indices: Vec<usize> = (0..spec.lines).collect();
-    let lines = crate::map::compute_lines(&scene, &spec, &indices, None, &cache, &|_| {})?;
-    let traced = crate::boundary::trace_cached(&scene, &spec, None, &cache, &|_, _| {})?;
+    let lines = crate::study::map::compute_lines(&scene, &spec, &indices, None, &cache, &|_| {})?;
+    let traced = crate::study::boundary::trace_cached(&scene, &spec, None, &cache, &|_, _| {})?;
     let _ = std::fs::remove_dir_all(&cache);
-    let map = crate::map::assemble(name, &spec, cont.range, lines, Some(traced));
+    let map = crate::study::map::assemble(name, &spec, cont.range, lines, Some(traced));
     let mut s = String::new();
     writeln!(
         s,
@@ -532,9 +533,9 @@ fn island_table_of(scenes: &Path, name: &str, paper: &[&str]) -> Result<String> 
 /// thin sliver of another class.
 fn refined_ends(
     scene: &Scene,
-    spec: &crate::map::MapSpec,
-    map: &crate::map::Map,
-    t: &crate::boundary::Traced,
+    spec: &crate::study::map::MapSpec,
+    map: &crate::study::map::Map,
+    t: &crate::study::boundary::Traced,
 ) -> Result<String> {
     let mut s = String::new();
     let mut fine = scene.clone();
@@ -573,7 +574,7 @@ fn refined_ends(
             )?;
             writeln!(s, "|---|---|---|---|")?;
         }
-        let refined = crate::map::line(&fine, spec, l.index, None);
+        let refined = crate::study::map::line(&fine, spec, l.index, None);
         let ends: Vec<(f64, String)> = refined
             .intervals
             .iter()
@@ -597,7 +598,7 @@ fn refined_ends(
 }
 
 /// The boundary walked by two-parameter continuation, against the grid.
-fn traced_table(t: &crate::boundary::Traced) -> Result<String> {
+fn traced_table(t: &crate::study::boundary::Traced) -> Result<String> {
     let mut s = String::new();
     writeln!(
         s,
@@ -665,12 +666,12 @@ fn traced_table(t: &crate::boundary::Traced) -> Result<String> {
 fn run_text(
     text: &str,
 ) -> Result<(
-    Vec<crate::equilibrium::Equilibrium>,
-    Vec<crate::branch::Event>,
+    Vec<crate::analysis::equilibrium::Equilibrium>,
+    Vec<crate::study::branch::Event>,
 )> {
     let scene = Scene::parse(text)?;
     let mut eqs = Vec::new();
-    let events = crate::run::run_scene(&scene, None, &mut |e| {
+    let events = crate::study::run::run_scene(&scene, None, &mut |e| {
         eqs.push(e);
         Ok(())
     })?;
@@ -739,7 +740,7 @@ fn strip_table(scenes: &Path) -> Result<String> {
             .filter(|e| e.kind == "fold" || e.kind == "branch_point")
             .count();
         for z in [0.115, 0.150, 0.180, 0.200, 0.215] {
-            let mut pts: Vec<&crate::equilibrium::Equilibrium> =
+            let mut pts: Vec<&crate::analysis::equilibrium::Equilibrium> =
                 eqs.iter().filter(|e| (e.z_star - z).abs() < 1e-9).collect();
             pts.sort_by(|a, b| a.phi_over_2pi.total_cmp(&b.phi_over_2pi));
             let mut intervals = Vec::new();
@@ -785,7 +786,7 @@ fn double_ring_table() -> Result<String> {
         let scene = Scene::parse(&format!(
             "[model]\nsegments = {n}\n[clamps]\nz_star = 0.0\ndelta = 0.0\nphi_over_2pi = 1.0\n[initial]\nshape = \"double_ring\"\nsteps = 1\n"
         ))?;
-        let (_, ring, _) = crate::equilibrium::starting_equilibrium(&scene, None)?;
+        let (_, ring, _) = crate::study::start::starting_equilibrium(&scene, None)?;
         let lowest = |k: f64| -> Result<f64> {
             let energy = RodEnergy::new(RodModel {
                 segments: n,
@@ -797,8 +798,8 @@ fn double_ring_table() -> Result<String> {
             let mut g = vec![0.0; energy.map.len()];
             let mut v = vec![0.0; energy.pattern.nnz()];
             energy.hessian(&ring, &mut g, &mut v);
-            let mut ldlt = crate::solve::sparse::Ldlt::new(&energy.pattern);
-            let sp = crate::stability::lowest_eigenvalues(&energy.pattern, &v, None, 1, &mut ldlt)?;
+            let mut ldlt = crate::linalg::sparse::Ldlt::new(&energy.pattern);
+            let sp = crate::linalg::eigen::lowest_eigenvalues(&energy.pattern, &v, None, 1, &mut ldlt)?;
             Ok(sp.values[0])
         };
         let (mut lo, mut hi) = (1.5, 2.5);
@@ -817,13 +818,13 @@ fn double_ring_table() -> Result<String> {
 }
 
 fn asymptotics_table() -> Result<String> {
-    use crate::asymptotics::{curve_i, curve_ii, max_one_contact_z_star, one_contact_shifts};
+    use crate::study::asymptotics::{curve_i, curve_ii, max_one_contact_z_star, one_contact_shifts};
     let mut s = String::new();
     writeln!(
         s,
         "Along Δφ = 0.8 z* (N = 200): the end shifts δ_I, δ_II where the strands pass at c1, c2, against eqs. (6.15), (6.18) with exact coefficients ({:.4}, {:.4}).\n",
-        crate::asymptotics::curve_i_first_order(),
-        crate::asymptotics::curve_i_second_order()
+        crate::study::asymptotics::curve_i_first_order(),
+        crate::study::asymptotics::curve_i_second_order()
     )?;
     writeln!(
         s,
@@ -863,10 +864,10 @@ fn map3_table(scenes: &Path) -> Result<String> {
         let cache =
             std::env::temp_dir().join(format!("knotrod-validate-fig9-{}-{k}", std::process::id()));
         let idx: Vec<usize> = (0..sspec.lines).collect();
-        let lines = crate::map::compute_lines(&slice, &sspec, &idx, None, &cache, &|_| {})?;
-        let traced = crate::boundary::trace_cached(&slice, &sspec, None, &cache, &|_, _| {})?;
+        let lines = crate::study::map::compute_lines(&slice, &sspec, &idx, None, &cache, &|_| {})?;
+        let traced = crate::study::boundary::trace_cached(&slice, &sspec, None, &cache, &|_, _| {})?;
         let _ = std::fs::remove_dir_all(&cache);
-        maps.push(crate::map::assemble(
+        maps.push(crate::study::map::assemble(
             "fig9",
             &sspec,
             cont.range,
@@ -874,7 +875,7 @@ fn map3_table(scenes: &Path) -> Result<String> {
             Some(traced),
         ));
     }
-    let m3 = crate::map::assemble_3d("fig9_strip_3d", &slices, maps);
+    let m3 = crate::study::map::assemble_3d("fig9_strip_3d", &slices, maps);
     let mut s = String::new();
     writeln!(
         s,
@@ -929,7 +930,7 @@ fn map3_table(scenes: &Path) -> Result<String> {
         let slice = slices.scene(&scene, k);
         let sspec = slice.map.clone().unwrap();
         let n = 2 * scene.model.segments as usize;
-        let t = crate::boundary::trace_island(&slice, &sspec, Some(n), &|_, _| {})?;
+        let t = crate::study::boundary::trace_island(&slice, &sspec, Some(n), &|_, _| {})?;
         let fine = t
             .bounding_box
             .get("z_star")

@@ -4,9 +4,10 @@
 
 use super::condition::{Condition, Failure, Other, Strands, closest_strands, strand_distance};
 use super::{Traced, Trail, finish};
-use crate::equilibrium::{Measure, starting_equilibrium};
+use crate::analysis::equilibrium::Measure;
+use crate::study::start::starting_equilibrium;
 use crate::geometry::closure::closure_knot;
-use crate::map::MapSpec;
+use crate::study::map::MapSpec;
 use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
@@ -161,7 +162,7 @@ impl Walk<'_, '_> {
                          (lowest eigenvalue on the constraints' tangent space) is not traced"
                     );
                 }
-                let sp = crate::stability::lowest_eigenvalues(
+                let sp = crate::linalg::eigen::lowest_eigenvalues(
                     &energy.pattern,
                     &site.point.hessian,
                     None,

@@ -6,10 +6,11 @@
 //! the boundary curves. Maps shard (`--shard i/n`, `knotrod merge`) and resume
 //! from the lines already written.
 
-use crate::branch::{BranchOptions, BranchRun, Event};
-use crate::equilibrium::{Equilibrium, Measure, starting_equilibrium};
+use crate::study::branch::{BranchOptions, BranchRun, Event};
+use crate::analysis::equilibrium::{Equilibrium, Measure};
+use crate::study::start::starting_equilibrium;
 use crate::model::rod::Parameter;
-use crate::run::reach;
+use crate::study::run::reach;
 use crate::scene::Scene;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
@@ -111,7 +112,7 @@ pub struct Map {
     pub grid_boundaries: BTreeMap<String, Vec<[f64; 2]>>,
     /// The boundary traced by two-parameter continuation from the start.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub traced: Option<crate::boundary::Traced>,
+    pub traced: Option<crate::study::boundary::Traced>,
     /// Classified grid: rows = lines, columns = `grid_phi`.
     pub grid: Vec<Vec<Class>>,
     /// φ/2π of the grid columns.
@@ -491,7 +492,7 @@ pub fn assemble(
     spec: &MapSpec,
     phi_range: [f64; 2],
     mut lines: Vec<Line>,
-    traced: Option<crate::boundary::Traced>,
+    traced: Option<crate::study::boundary::Traced>,
 ) -> Map {
     lines.sort_by_key(|l| l.index);
     lines.dedup_by_key(|l| l.index);
@@ -532,7 +533,7 @@ pub fn assemble(
     }
     let grid_boundaries = chain_boundaries(&ends);
     let traced = traced.map(|mut t| {
-        t.grid_check = crate::boundary::grid_check(&t, &lines);
+        t.grid_check = crate::study::boundary::grid_check(&t, &lines);
         t
     });
     let boundaries = match &traced {
@@ -655,7 +656,7 @@ pub struct Partial {
     pub lines: Vec<Line>,
     /// The traced boundary (shard 0 computes it).
     #[serde(default)]
-    pub traced: Option<crate::boundary::Traced>,
+    pub traced: Option<crate::study::boundary::Traced>,
 }
 
 /// Merge partial results into a map.

@@ -26,7 +26,7 @@ mod walk;
 
 pub use condition::{Condition, Other, Strands};
 
-use crate::map::{Line, MapSpec};
+use crate::study::map::{Line, MapSpec};
 use crate::model::rod::Parameter;
 use crate::scene::Scene;
 use anyhow::{Context, Result};

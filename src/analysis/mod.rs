@@ -1,0 +1,4 @@
+//! One equilibrium measured: clamp reactions, twist, walls, distances, knot
+//! type, stability (contacts held), its class, and the typed events of a path.
+
+pub mod equilibrium;

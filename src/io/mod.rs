@@ -1,0 +1,7 @@
+//! Files: scene files, restart states, MCAP recordings (writer, reader,
+//! Foxglove geometry), JSON summaries and map files, plots, exports.
+
+pub mod export;
+pub mod plot;
+pub mod recording;
+pub mod summary;

@@ -1,0 +1,6 @@
+//! Reports computed from the library: the validation report, analytic
+//! checks, and the benchmark.
+
+pub mod analytic;
+pub mod bench;
+pub mod validation;

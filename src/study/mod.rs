@@ -1,0 +1,11 @@
+//! What a user runs: the starting equilibrium, branches (continuation with
+//! located events), sweeps, loading paths, maps and the boundary walk,
+//! asymptotics. Results go to observers; nothing here touches files.
+
+pub mod asymptotics;
+pub mod boundary;
+pub mod branch;
+pub mod loading;
+pub mod map;
+pub mod run;
+pub mod start;

@@ -1,0 +1,185 @@
+//! The starting equilibrium of a scene: its initial shape (straight, shooting,
+//! double ring, trefoil, or a restart state) relaxed by the minimiser.
+
+use crate::analysis::equilibrium::{Equilibrium, Measure, Shape, analyse};
+use crate::model::rod::{Clamps, RodModel, RodState};
+use crate::model::shooting::{ShootingSolution, refine_shooting};
+use crate::model::energy::RodEnergy;
+use crate::scene::{InitialShape, Scene};
+use crate::solve::newton::{Newton, NewtonReport};
+use anyhow::{Context, Result, bail};
+use nalgebra::Vector3;
+
+/// The initial state a scene asks for, at N segments.
+pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
+    let clamps = scene.clamps();
+    let n = model.segments;
+    let init = &scene.initial;
+    if let Some(path) = &init.from_recording {
+        let msg =
+            crate::io::recording::read_state(path, init.index as u64).context("initial.from_recording")?;
+        let mut state = msg.state;
+        if state.segments() != n {
+            bail!(
+                "initial.from_recording: state has {} segments, model.segments is {n}",
+                state.segments()
+            );
+        }
+        state.set_clamps(clamps);
+        return Ok(state);
+    }
+    Ok(match init.shape {
+        InitialShape::Straight => match init.bump {
+            None => RodState::straight(n, clamps),
+            Some(b) => {
+                let (end, phi, b) = (clamps.end_point(), clamps.phi, Vector3::from(b));
+                RodState::from_curve(
+                    n,
+                    clamps,
+                    move |s| end * s + b * (0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos())),
+                    move |s| Vector3::new((phi * s).cos(), (phi * s).sin(), 0.0),
+                )
+            }
+        },
+        InitialShape::DoubleRing => {
+            // a circle of circumference 1/2 traced twice in the (y, z) plane,
+            // bent about d1 = e1 everywhere (paper Sec. 6); the clamps are the
+            // scene's, so small z*, δ, 2π − φ start the unfolding directly
+            let r = 1.0 / (4.0 * std::f64::consts::PI);
+            RodState::from_curve(
+                n,
+                clamps,
+                move |s| {
+                    let a = 4.0 * std::f64::consts::PI * s;
+                    Vector3::new(0.0, -r * (1.0 - a.cos()), r * a.sin())
+                },
+                |_| Vector3::x(),
+            )
+        }
+        InitialShape::Trefoil => {
+            let mut state = RodState::from_curve(
+                n,
+                clamps,
+                crate::model::trefoil::trefoil_centreline(clamps.end_point()),
+                |_| Vector3::x(),
+            );
+            // uniform twist, with the whole turns that give the asked link:
+            // m_i = c at every vertex, n c = φ + reference twist at the end
+            let target = init.link.unwrap_or(3) as f64 + clamps.phi_over_2pi();
+            let rt = state.reference_twist[n];
+            let set = |state: &mut RodState, turns: f64| {
+                let c = (clamps.phi + rt + 2.0 * std::f64::consts::PI * turns) / n as f64;
+                for j in 1..n {
+                    state.theta[j] = j as f64 * c;
+                }
+                state.reference_twist[n] = rt + 2.0 * std::f64::consts::PI * turns;
+            };
+            set(&mut state, 0.0);
+            let shape = Shape::of(&state, &Measure::of(scene));
+            if shape.knot.determinant != 3 {
+                bail!(
+                    "initial.shape = \"trefoil\": at z* = {}, δ = {} the guide curve's ray \
+                     closure is not a trefoil (knot determinant {}); start from the \
+                     paper's clamps (z* ≈ 0.115, δ ≈ 0.05) and load from there",
+                    clamps.z_star,
+                    clamps.delta,
+                    shape.knot.determinant
+                );
+            }
+            let turns = (target - state.twist() - shape.writhe).round();
+            set(&mut state, turns);
+            state
+        }
+        InitialShape::Shooting => {
+            let (mut n0, mut m0) = (
+                Vector3::from(init.n0.context("initial.n0 missing")?),
+                Vector3::from(init.m0.context("initial.m0 missing")?),
+            );
+            let steps = init.steps.map_or(20_000, |s| s as usize);
+            if init.refine {
+                (n0, m0) = refine_shooting(n0, m0, model.k2, model.k3, &clamps, steps)
+                    .context("initial.refine: shooting refinement did not converge")?;
+            }
+            let sol = ShootingSolution::integrate(n0, m0, model.k2, model.k3, steps);
+            RodState::from_curve(n, clamps, |s| sol.position(s), |s| sol.d1(s))
+        }
+        InitialShape::File => {
+            let path = init.file.as_ref().context("initial.file missing")?;
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("initial.file: cannot read {}", path.display()))?;
+            let summary: serde_json::Value = serde_json::from_str(&text)
+                .with_context(|| format!("initial.file: {} is not JSON", path.display()))?;
+            let entry = summary
+                .get("equilibria")
+                .and_then(|e| e.get(init.index))
+                .and_then(|e| e.get("state"))
+                .with_context(|| {
+                    format!(
+                        "initial.index: {} has no equilibria[{}].state",
+                        path.display(),
+                        init.index
+                    )
+                })?;
+            let mut state: RodState = serde_json::from_value(entry.clone())
+                .with_context(|| format!("initial.file: malformed state in {}", path.display()))?;
+            if state.segments() != n
+                || state.theta.len() != n + 1
+                || state.reference.len() != n + 1
+                || state.reference_twist.len() != n + 1
+            {
+                bail!(
+                    "initial.file: state has {} segments, model.segments is {n}",
+                    state.segments()
+                );
+            }
+            state.set_clamps(clamps);
+            state
+        }
+    })
+}
+
+/// The scene's starting equilibrium at N segments (the scene's if None): its
+/// initial shape relaxed by Newton, with the minimiser that found it.
+pub fn starting_equilibrium(
+    scene: &Scene,
+    segments: Option<usize>,
+) -> Result<(Newton, RodState, NewtonReport)> {
+    let model = scene.rod_model(segments);
+    let mut newton = Newton::new(RodEnergy::new(model.clone()));
+    newton.contact = scene.contact_model();
+    if scene.initial.shape == InitialShape::DoubleRing {
+        // unfold the double ring quasi-statically: straight from its own
+        // clamps (0, 0, 2π) to the scene's
+        let ring = Clamps::new(0.0, 0.0, 1.0);
+        let mut state = initial_state(scene, &model)?;
+        state.set_clamps(ring);
+        let mut report = newton
+            .minimize(&mut state, &scene.solver)
+            .context("the double ring")?;
+        let target = scene.clamps();
+        let steps = scene.initial.steps.map_or(40, |s| s as usize);
+        for k in 1..=steps {
+            let f = k as f64 / steps as f64;
+            let c = Clamps {
+                z_star: f * target.z_star,
+                delta: f * target.delta,
+                phi: ring.phi + f * (target.phi - ring.phi),
+            };
+            let step = crate::study::loading::carry(&mut newton, &state, c, &scene.solver)
+                .with_context(|| format!("unfolding the double ring, step {k} of {steps}"))?;
+            (state, report) = (step.state, step.report);
+        }
+        return Ok((newton, state, report));
+    }
+    let mut state = initial_state(scene, &model)?;
+    let report = newton
+        .minimize(&mut state, &scene.solver)
+        .context("Newton minimisation")?;
+    Ok((newton, state, report))
+}
+
+/// Solve a scene's single equilibrium at N segments (the scene's own N if None).
+pub fn solve_scene(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
+    let (mut newton, state, report) = starting_equilibrium(scene, segments)?;
+    analyse(&mut newton, &state, &report, &Measure::of(scene))
+}
