@@ -6,20 +6,21 @@
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use knotrod::analysis::equilibrium::{Measure, Shape, analyse};
-use knotrod::study::start::solve_scene;
+use knotrod::linalg::eigen::lowest_eigenvalues;
+use knotrod::linalg::sparse::Ldlt;
 use knotrod::model::energy::RodEnergy;
 use knotrod::model::rod::Parameter;
 use knotrod::scene::Scene;
 use knotrod::solve::continuation::{ContinuationSettings, Tracer};
-use knotrod::solve::newton::Newton;
-use knotrod::linalg::sparse::Ldlt;
-use knotrod::linalg::eigen::lowest_eigenvalues;
+use knotrod::solve::minimizer::Minimizer;
+use knotrod::study::start::solve_scene;
 use std::path::Path;
 
 const SIZES: [usize; 6] = [100, 200, 400, 800, 1600, 3200];
 
 /// Builds the measured closure for one N from its equilibrium.
-type Setup<'a> = &'a dyn Fn(usize, &knotrod::analysis::equilibrium::Equilibrium) -> Box<dyn FnMut()>;
+type Setup<'a> =
+    &'a dyn Fn(usize, &knotrod::analysis::equilibrium::Equilibrium) -> Box<dyn FnMut()>;
 
 fn bench(c: &mut Criterion) {
     let d = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
@@ -96,7 +97,7 @@ fn bench(c: &mut Criterion) {
     });
     group("continuation_step", &|n, eq| {
         let energy = RodEnergy::new(d.rod_model(Some(n)));
-        let mut newton = Newton::new(energy);
+        let mut newton = Minimizer::new(energy);
         let state = eq.state.clone();
         let previous = eq.clone();
         Box::new(move || {
@@ -104,7 +105,7 @@ fn bench(c: &mut Criterion) {
                 Tracer::new(&mut newton, Parameter::Phi, ContinuationSettings::default());
             let a = tracer.start(state.clone(), 1.0).unwrap();
             let b = tracer.correct(&a, 0.005, None).unwrap();
-            let report = knotrod::solve::newton::NewtonReport {
+            let report = knotrod::solve::outcome::SolveReport {
                 converged: true,
                 iterations: b.iterations,
                 residual_history: vec![],

@@ -1,10 +1,12 @@
 //! Analytic cases: uniform twist, Euler buckling, torsional buckling of a
 //! clamped-clamped rod, with convergence in N.
 
-use knotrod::report::analytic::{self, euler_buckling_load, greenhill_constant, greenhill_twisting_moment};
 use knotrod::model::energy::RodEnergy;
 use knotrod::model::rod::{Clamps, RodModel, RodState};
-use knotrod::solve::newton::Newton;
+use knotrod::report::analytic::{
+    self, euler_buckling_load, greenhill_constant, greenhill_twisting_moment,
+};
+use knotrod::solve::minimizer::Minimizer;
 use std::f64::consts::PI;
 
 fn model(n: usize, k2: f64, k3: f64) -> RodModel {
@@ -17,7 +19,7 @@ fn model(n: usize, k2: f64, k3: f64) -> RodModel {
     }
 }
 
-fn straight_equilibrium(newton: &mut Newton, clamps: Clamps) -> (RodState, usize) {
+fn straight_equilibrium(newton: &mut Minimizer, clamps: Clamps) -> (RodState, usize) {
     analytic::straight_equilibrium(newton, clamps).expect("converges")
 }
 
@@ -25,7 +27,7 @@ fn straight_equilibrium(newton: &mut Newton, clamps: Clamps) -> (RodState, usize
 fn straight_rod_twisted_by_phi_has_exact_twist_and_energy() {
     // twisting moments K3 φ = 5.7, 8.2, 7.1: all below the buckling moment 8.99
     for (n, phi_over_2pi, k3) in [(20, 0.3, 3.0), (50, 1.3, 1.0), (200, -0.75, 1.5)] {
-        let mut newton = Newton::new(RodEnergy::new(model(n, 1.0, k3)));
+        let mut newton = Minimizer::new(RodEnergy::new(model(n, 1.0, k3)));
         let clamps = Clamps::new(1.0, 0.0, phi_over_2pi);
         let (st, neg) = straight_equilibrium(&mut newton, clamps);
         let phi = 2.0 * PI * phi_over_2pi;

@@ -1,11 +1,11 @@
 //! Contact: a clamped beam pushed onto a point obstacle (beam theory), and
 //! the trefoil tied around the rays (configurations A → B → C, Figures 3-5).
 
-use knotrod::study::branch::Event;
 use knotrod::analysis::equilibrium::Equilibrium;
-use knotrod::study::start::solve_scene;
-use knotrod::study::run::run_scene;
 use knotrod::scene::Scene;
+use knotrod::study::branch::Event;
+use knotrod::study::run::run_scene;
+use knotrod::study::start::solve_scene;
 
 /// A straight clamped-clamped rod (z* = 1) whose midpoint is pushed sideways
 /// by `deflection` by a segment obstacle across it.
@@ -288,7 +288,10 @@ fn trefoil_generator_is_a_trefoil_or_says_why_not() {
     let scene = Scene::parse(&text(0.115)).unwrap();
     let model = scene.rod_model(None);
     let state = knotrod::study::start::initial_state(&scene, &model).unwrap();
-    let shape = knotrod::analysis::equilibrium::Shape::of(&state, &knotrod::analysis::equilibrium::Measure::of(&scene));
+    let shape = knotrod::analysis::equilibrium::Shape::of(
+        &state,
+        &knotrod::analysis::equilibrium::Measure::of(&scene),
+    );
     assert_eq!(shape.knot.determinant, 3);
     assert!((state.twist() + shape.writhe - 3.0).abs() < 1e-9);
     let err = solve_scene(&Scene::parse(&text(0.3)).unwrap(), None).unwrap_err();

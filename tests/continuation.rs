@@ -1,10 +1,10 @@
 //! Continuation and quasi-static loading: folds, jumps, hysteresis, and the
 //! paper's Figure 3 branch.
 
-use knotrod::study::branch::Event;
 use knotrod::analysis::equilibrium::Equilibrium;
-use knotrod::study::run::run_scene;
 use knotrod::scene::Scene;
+use knotrod::study::branch::Event;
+use knotrod::study::run::run_scene;
 
 fn run(scene: &Scene) -> (Vec<Equilibrium>, Vec<Event>) {
     let mut eqs = Vec::new();
@@ -273,10 +273,10 @@ fn twisting_a_buckled_rod_snaps_at_two_different_angles() {
 /// then in φ, reaches along another path.
 #[test]
 fn settling_at_new_clamps_finds_the_equilibrium_continuation_reaches() {
-    use knotrod::study::start::starting_equilibrium;
     use knotrod::model::rod::{Clamps, Parameter};
-    use knotrod::study::run::reach;
     use knotrod::solve::continuation::Tracer;
+    use knotrod::study::run::reach;
+    use knotrod::study::start::starting_equilibrium;
     let scene = Scene::load(std::path::Path::new("scenes/fig7_island_kirchhoff.toml")).unwrap();
     let settings = scene.continuation.as_ref().unwrap().settings();
     let (mut newton, start, _) = starting_equilibrium(&scene, Some(60)).unwrap();

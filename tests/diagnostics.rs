@@ -1,11 +1,11 @@
 //! Knot diagnostics of the paper's equilibria, self-distance against brute
 //! force, and the convergence of the writhe as the closing rays grow.
 
-use knotrod::study::start::solve_scene;
 use knotrod::geometry::closure::ray_closure;
 use knotrod::geometry::distance::{min_self_distance, min_self_distance_brute};
 use knotrod::geometry::writhe::writhe_closed;
 use knotrod::scene::Scene;
+use knotrod::study::start::solve_scene;
 use nalgebra::Vector3;
 use std::path::Path;
 

@@ -1,11 +1,11 @@
 //! Appendices D and E of the paper, solved as discrete rods from the paper's
 //! shooting data.
 
-use knotrod::study::start::solve_scene;
+use knotrod::io::summary::relative_deviation;
 use knotrod::model::rod::Clamps;
 use knotrod::model::shooting::refine_shooting;
 use knotrod::scene::Scene;
-use knotrod::io::summary::relative_deviation;
+use knotrod::study::start::solve_scene;
 use nalgebra::Vector3;
 use std::path::Path;
 

@@ -1,11 +1,12 @@
 //! The sparse shift-invert eigenvalues and the inertia against dense
 //! eigen-decompositions, for the plain Hessian and the lumped-mass pencil.
 
+use knotrod::linalg::eigen::lowest_eigenvalues;
 use knotrod::model::energy::RodEnergy;
 use knotrod::model::rod::{Clamps, RodModel, RodState};
 use knotrod::model::shooting::ShootingSolution;
-use knotrod::solve::newton::{Newton, NewtonSettings};
-use knotrod::linalg::eigen::lowest_eigenvalues;
+use knotrod::solve::minimizer::Minimizer;
+use knotrod::solve::outcome::SolverSettings;
 use nalgebra::{DMatrix, Vector3};
 
 fn dense_lowest(h: &DMatrix<f64>, mass: Option<&[f64]>) -> Vec<f64> {
@@ -98,9 +99,9 @@ fn stable_knot(n: usize) {
         4000,
     );
     let mut st = RodState::from_curve(n, clamps, |s| sol.position(s), |s| sol.d1(s));
-    let mut newton = Newton::new(RodEnergy::new(model));
+    let mut newton = Minimizer::new(RodEnergy::new(model));
     newton
-        .minimize(&mut st, &NewtonSettings::default())
+        .minimize(&mut st, &SolverSettings::default())
         .unwrap();
     check(&newton.energy, &st, false);
 }

@@ -3,20 +3,21 @@
 //! on the constraint tangent space; the double ring's stability criterion
 //! (paper eq. 2.7); Figure 8.
 
-use knotrod::study::branch::Event;
 use knotrod::analysis::equilibrium::Equilibrium;
-use knotrod::study::start::starting_equilibrium;
+use knotrod::linalg::eigen::lowest_eigenvalues;
+use knotrod::linalg::sparse::Ldlt;
 use knotrod::model::energy::RodEnergy;
 use knotrod::model::rod::{Law, RodModel, RodState};
-use knotrod::study::run::run_scene;
 use knotrod::scene::Scene;
-use knotrod::solve::newton::{Newton, NewtonSettings};
-use knotrod::linalg::sparse::Ldlt;
-use knotrod::linalg::eigen::lowest_eigenvalues;
+use knotrod::solve::minimizer::Minimizer;
+use knotrod::solve::outcome::SolverSettings;
+use knotrod::study::branch::Event;
+use knotrod::study::run::run_scene;
+use knotrod::study::start::starting_equilibrium;
 use nalgebra::DMatrix;
 
 /// The double ring (z* = δ = 0, φ = 2π) of `kind` at N segments, relaxed.
-fn double_ring(kind: &str, segments: usize) -> (Newton, RodState) {
+fn double_ring(kind: &str, segments: usize) -> (Minimizer, RodState) {
     let scene = Scene::parse(&format!(
         "[model]\nkind = \"{kind}\"\nsegments = {segments}\n[clamps]\nz_star = 0.0\ndelta = 0.0\nphi_over_2pi = 1.0\n[initial]\nshape = \"double_ring\"\nsteps = 1\n"
     ))
@@ -163,9 +164,9 @@ fn unbendable_rod_is_the_limit_of_large_k2() {
     let mut gaps = Vec::new();
     for k2 in [1e2, 1e3, 1e4] {
         let mut state = limit.clone();
-        let mut newton = Newton::new(RodEnergy::new(kirchhoff(50, k2, 3.0, Law::Kirchhoff)));
+        let mut newton = Minimizer::new(RodEnergy::new(kirchhoff(50, k2, 3.0, Law::Kirchhoff)));
         let r = newton
-            .minimize(&mut state, &NewtonSettings::default())
+            .minimize(&mut state, &SolverSettings::default())
             .unwrap();
         assert!(r.converged);
         let gap = state.largest_node_distance(&limit);

@@ -6,13 +6,14 @@ use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
 use crate::geometry::knot::KnotType;
 use crate::geometry::walls::wall_clearance;
 use crate::geometry::writhe::writhe_closed;
+use crate::linalg::eigen::lowest_eigenvalues;
+use crate::model::contact_hessian::ContactHessian;
 use crate::model::energy::{RodEnergy, vertex_strains};
 use crate::model::rod::{Clamps, Law, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
 use crate::scene::{InitialShape, Scene};
-use crate::solve::newton::{Newton, NewtonReport};
-use crate::solve::sqp::Widened;
-use crate::linalg::eigen::lowest_eigenvalues;
+use crate::solve::minimizer::Minimizer;
+use crate::solve::outcome::SolveReport;
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -93,7 +94,7 @@ pub struct Equilibrium {
     pub regularised: Option<bool>,
     /// Contacts (with a `[contact]` model): arc length, obstacle, force.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub contacts: Vec<crate::solve::sqp::ContactForce>,
+    pub contacts: Vec<crate::model::contact::ContactForce>,
     /// Sum of the contact forces' magnitudes.
     #[serde(default)]
     pub contact_force: f64,
@@ -235,11 +236,11 @@ impl Shape {
 /// tangent space of the active contacts (self-contacts included, on the
 /// pattern widened by their couplings). None without held contacts.
 fn hold_contacts(
-    newton: &Newton,
+    newton: &Minimizer,
     state: &RodState,
-    report: &NewtonReport,
+    report: &SolveReport,
     values: &[f64],
-) -> Option<Widened> {
+) -> Option<ContactHessian> {
     let model = newton.contact.as_ref()?;
     let held: Vec<&(crate::model::contact::Gap, f64)> = report
         .contact_rows
@@ -257,7 +258,7 @@ fn hold_contacts(
         .map(|&s| values[s].abs())
         .fold(0.0, f64::max);
     let gaps: Vec<&crate::model::contact::Gap> = held.iter().map(|(g, _)| g).collect();
-    let mut wide = Widened::new(energy, &gaps);
+    let mut wide = ContactHessian::new(energy, &gaps);
     wide.fill(
         energy,
         values,
@@ -271,9 +272,9 @@ fn hold_contacts(
 
 /// Measure an equilibrium found by `newton` (its energy is reused for the Hessian).
 pub fn analyse(
-    newton: &mut Newton,
+    newton: &mut Minimizer,
     state: &RodState,
-    report: &NewtonReport,
+    report: &SolveReport,
     measure: &Measure,
 ) -> Result<Equilibrium> {
     analyse_from(newton, state, report, measure, None, None)
@@ -284,9 +285,9 @@ pub fn analyse(
 /// have passed through another: see [`Shape::continued`]), and with the
 /// Hessian at `state` when the caller has it already.
 pub fn analyse_from(
-    newton: &mut Newton,
+    newton: &mut Minimizer,
     state: &RodState,
-    report: &NewtonReport,
+    report: &SolveReport,
     measure: &Measure,
     previous: Option<&Equilibrium>,
     hessian: Option<&[f64]>,
@@ -400,4 +401,3 @@ pub fn analyse_from(
         state: state.clone(),
     })
 }
-

@@ -5,10 +5,10 @@ use crate::geometry::knot::knot_type;
 use crate::geometry::polyline::read_points;
 use crate::geometry::writhe::writhe_closed;
 use crate::io::plot::{PlotPoint, bifurcation_diagram};
-use crate::study::run::run_scene;
-use crate::scene::Scene;
 use crate::io::summary::{Summary, print_equilibrium, print_events};
 use crate::report::validation;
+use crate::scene::Scene;
+use crate::study::run::run_scene;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use nalgebra::Vector3;
@@ -683,10 +683,11 @@ fn map_plane(
         Some((i, _)) if i != 0 => None,
         _ => {
             let spinner = indicatif::ProgressBar::new_spinner();
-            let t = crate::study::boundary::trace_cached(scene, &spec, segments, &cache, &|k, on| {
-                spinner.set_message(format!("tracing the boundary: point {k}, on {on}"));
-                spinner.tick();
-            })?;
+            let t =
+                crate::study::boundary::trace_cached(scene, &spec, segments, &cache, &|k, on| {
+                    spinner.set_message(format!("tracing the boundary: point {k}, on {on}"));
+                    spinner.tick();
+                })?;
             spinner.finish_and_clear();
             Some(t)
         }

@@ -4,8 +4,8 @@
 //! and the minimum self-distance along the branches. SVG always; PNG when a
 //! TrueType font is found for the labels.
 
-use crate::study::branch::Event;
 use crate::analysis::equilibrium::Equilibrium;
+use crate::study::branch::Event;
 use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -316,7 +316,10 @@ pub fn island_map(stem: &Path, map: &crate::study::map::Map) -> Result<Vec<std::
 
 /// A 3D map as stacked slices, one panel each (SVG, and PNG when a font is
 /// available).
-pub fn island_slices(stem: &Path, map: &crate::study::map::Map3) -> Result<Vec<std::path::PathBuf>> {
+pub fn island_slices(
+    stem: &Path,
+    map: &crate::study::map::Map3,
+) -> Result<Vec<std::path::PathBuf>> {
     let n = map.slices.len().max(1);
     let cols = n.min(4);
     let rows = n.div_ceil(cols);
@@ -345,7 +348,10 @@ pub fn island_slices(stem: &Path, map: &crate::study::map::Map3) -> Result<Vec<s
     Ok(written)
 }
 
-fn draw_map<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, map: &crate::study::map::Map) -> Result<()>
+fn draw_map<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    map: &crate::study::map::Map,
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {

@@ -270,3 +270,17 @@ pub fn self_pairs(
     let tree = CurveTree::new(points);
     tree.pairs_within(arc, gap, within)
 }
+
+/// A contact force of an equilibrium.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactForce {
+    /// Arc length on the rod.
+    pub s: f64,
+    /// What it touches ("ray_bottom", "ray_top", "obstacle_k", "self").
+    pub obstacle: String,
+    /// Magnitude of the normal force (the multiplier of gap ≥ 0), in units
+    /// of B/L².
+    pub force: f64,
+    /// Gap (distance − h) there: 0 in contact, to solver tolerance.
+    pub gap: f64,
+}

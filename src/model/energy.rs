@@ -9,10 +9,10 @@
 //! twist is continued from its stored value, exactly as the state update does,
 //! so these derivatives are those of the energy along the solver's own steps.
 
-use crate::model::frames::{self, Scalar, V3, lift};
 use crate::linalg::jet::{self, Jet3, Jet4, Jet8};
-use crate::model::rod::{DofMap, Law, RodModel, RodState, tangent};
 use crate::linalg::sparse::{NO_SLOT, SymmetricPattern};
+use crate::model::frames::{self, Scalar, V3, lift};
+use crate::model::rod::{DofMap, Law, RodModel, RodState, tangent};
 use nalgebra::Vector3;
 
 /// Which energy terms to include.

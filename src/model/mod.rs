@@ -3,6 +3,7 @@
 //! the continuum (shooting) ODE.
 
 pub mod contact;
+pub mod contact_hessian;
 pub mod energy;
 pub mod frames;
 pub mod rod;

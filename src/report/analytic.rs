@@ -3,19 +3,20 @@
 //! clamped-clamped rod (P = 4π² B/L²) and Greenhill's torsional buckling
 //! (M L/B = 2 x₁ with tan x₁ = x₁, i.e. 2.8606 π).
 
+use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
-use crate::solve::newton::{Newton, NewtonSettings};
-use crate::linalg::eigen::lowest_eigenvalues;
+use crate::solve::minimizer::Minimizer;
+use crate::solve::outcome::SolverSettings;
 use anyhow::{Result, ensure};
 use std::f64::consts::PI;
 
 /// The straight (uniformly twisted) equilibrium for `clamps`, stable or not,
 /// with its count of negative Hessian eigenvalues.
-pub fn straight_equilibrium(newton: &mut Newton, clamps: Clamps) -> Result<(RodState, usize)> {
+pub fn straight_equilibrium(newton: &mut Minimizer, clamps: Clamps) -> Result<(RodState, usize)> {
     let n = newton.energy.model.segments;
     let mut st = RodState::straight(n, clamps);
-    newton.find_equilibrium(&mut st, &NewtonSettings::default())?;
+    newton.find_equilibrium(&mut st, &SolverSettings::default())?;
     let mut g = vec![0.0; newton.energy.map.len()];
     let mut v = vec![0.0; newton.energy.pattern.nnz()];
     newton.energy.hessian(&st, &mut g, &mut v);
@@ -52,7 +53,7 @@ pub fn euler_buckling_load(n: usize, stretching_stiffness: f64) -> Result<f64> {
         stretching_stiffness,
         law: Default::default(),
     };
-    let mut newton = Newton::new(RodEnergy::new(model));
+    let mut newton = Minimizer::new(RodEnergy::new(model));
     let p_e = 4.0 * PI * PI;
     let s = stretching_stiffness;
     // an end shortening ε gives a compressive force ≈ S ε
@@ -73,7 +74,7 @@ pub fn greenhill_twisting_moment(n: usize, k3: f64, stretching_stiffness: f64) -
         stretching_stiffness,
         law: Default::default(),
     };
-    let mut newton = Newton::new(RodEnergy::new(model));
+    let mut newton = Minimizer::new(RodEnergy::new(model));
     let phi = loss_of_stability(7.0 / k3, 11.0 / k3, |phi| {
         Ok(straight_equilibrium(
             &mut newton,

@@ -2,7 +2,7 @@
 //! Every field is checked; errors name the field.
 
 use crate::model::rod::{Clamps, Law, Parameter, RodModel};
-use crate::solve::newton::NewtonSettings;
+use crate::solve::outcome::SolverSettings;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -25,7 +25,7 @@ pub struct Scene {
     pub initial: InitialSpec,
     /// Newton settings.
     #[serde(default)]
-    pub solver: NewtonSettings,
+    pub solver: SolverSettings,
     /// Stability settings.
     #[serde(default)]
     pub stability: StabilitySpec,

@@ -6,11 +6,12 @@
 //! continued on the KKT system instead: unknowns (q, λ), the constraint rows
 //! bordered in, stability from the inertia reduced to the tangent space.
 
+use crate::linalg::sparse::Ldlt;
 use crate::model::energy::ClampVelocity;
 use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::solve::kkt::Kkt;
-use crate::solve::newton::{Newton, SolveError, residual};
-use crate::linalg::sparse::Ldlt;
+use crate::solve::minimizer::Minimizer;
+use crate::solve::outcome::{SolveError, residual};
 use serde::{Deserialize, Serialize};
 
 /// Settings of one continuation.
@@ -91,7 +92,7 @@ pub enum ContinuationError {
 /// Traces branches of equilibria of one rod in one parameter.
 pub struct Tracer<'a> {
     /// Energy, factorisation workspace.
-    pub newton: &'a mut Newton,
+    pub newton: &'a mut Minimizer,
     /// The continuation parameter.
     pub parameter: Parameter,
     /// Settings.
@@ -118,7 +119,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 impl<'a> Tracer<'a> {
     /// A tracer in `parameter`.
     pub fn new(
-        newton: &'a mut Newton,
+        newton: &'a mut Minimizer,
         parameter: Parameter,
         settings: ContinuationSettings,
     ) -> Self {

@@ -6,8 +6,8 @@
 //! The inertia gives the stability on the constraint tangent space:
 //! negatives(KKT) = negatives(reduced Hessian) + number of constraints.
 
-use crate::model::energy::RodEnergy;
 use crate::linalg::sparse::{Ldlt, NO_SLOT, SymmetricPattern};
+use crate::model::energy::RodEnergy;
 
 /// KKT system of one constrained rod (unknowns: free dofs, then the N
 /// multipliers of vertices 1..=N).

@@ -1,8 +1,10 @@
-//! Solvers of the discrete rod: the minimiser (Newton, and SQP for
-//! constrained laws and contact) behind one entry point, the KKT system of
-//! constrained laws, pseudo-arclength continuation.
+//! Solvers of the discrete rod: one minimiser (Newton, and SQP for
+//! constrained laws and contact) behind [`minimizer::Minimizer`], the KKT
+//! system of constrained laws, pseudo-arclength continuation.
 
 pub mod continuation;
 pub mod kkt;
+pub mod minimizer;
 pub mod newton;
+pub mod outcome;
 pub mod sqp;

@@ -11,12 +11,14 @@
 //! Lagrangian with the new λ (no Maratos effect: full steps near the solution,
 //! quadratic convergence).
 
-use crate::model::contact::{ContactModel, Gap, Obstacle, gap_hessian};
+use crate::linalg::eigen::lowest_eigenvalues;
+use crate::linalg::sparse::{Ldlt, SymmetricPattern};
+use crate::model::contact::{ContactForce, ContactModel, Gap, Obstacle};
+use crate::model::contact_hessian::ContactHessian;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::RodState;
 use crate::solve::kkt::Kkt;
-use crate::solve::newton::{Newton, NewtonReport, NewtonSettings, SolveError, armijo, residual};
-use crate::linalg::sparse::{Ldlt, SymmetricPattern};
+use crate::solve::outcome::{SolveError, SolveReport, SolverSettings, armijo, residual};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettings, DefaultSolver, IPSolver, SolverStatus,
@@ -38,9 +40,9 @@ struct ConstraintMatrix {
 }
 
 impl ConstraintMatrix {
-    fn new(newton: &Newton) -> Self {
-        let map = newton.energy.map;
-        let n = newton.energy.model.segments;
+    fn new(energy: &RodEnergy) -> Self {
+        let map = energy.map;
+        let n = energy.model.segments;
         let mut entries: Vec<(usize, usize, usize, usize)> = Vec::new(); // col, row, row, a
         for r in 0..n {
             for (a, d) in map.vertex_stencil(r + 1).iter().enumerate() {
@@ -101,17 +103,6 @@ impl ConstraintMatrix {
     }
 }
 
-/// Largest |u2| over the vertices.
-pub fn max_normal_curvature(newton: &Newton, state: &RodState) -> f64 {
-    let h = newton.energy.model.segment_length();
-    newton
-        .energy
-        .constraint_rows(state)
-        .iter()
-        .map(|(c, _)| (c / h).abs())
-        .fold(0.0, f64::max)
-}
-
 fn qp_settings() -> DefaultSettings<f64> {
     DefaultSettings {
         verbose: false,
@@ -121,158 +112,17 @@ fn qp_settings() -> DefaultSettings<f64> {
     }
 }
 
-/// A Hessian on the energy's pattern widened by contact couplings (a
-/// self-contact couples distant nodes), with the contacts' terms added: the
-/// Lagrangian's curvature −z ∇²g of each contact with force z, and a penalty
-/// ρ ∇g ∇gᵀ (ρ > 0 holds the contacts in a stability analysis). The pattern
-/// and the symbolic factorisation depend only on which node groups touch, so
-/// they are kept while the contact set stays the same.
-pub struct Widened {
-    /// The widened pattern.
-    pub pattern: SymmetricPattern,
-    /// Values on it.
-    pub values: Vec<f64>,
-    /// Its factorisation workspace.
-    pub ldlt: Ldlt,
-    /// The nodes of each contact stencil it was built for.
-    contacts: Vec<Vec<usize>>,
-    /// Slot in the widened pattern of each slot of the energy's pattern.
-    energy_slots: Vec<usize>,
-}
-
-/// Nodes whose positions a contact's gap depends on.
-fn contact_nodes(g: &Gap) -> Vec<usize> {
-    let [i, j] = g.segments;
-    if matches!(g.obstacle, Obstacle::SelfAt(_)) {
-        vec![i, i + 1, j, j + 1]
-    } else {
-        vec![i, i + 1]
-    }
-}
-
-impl Widened {
-    /// The widened pattern (and its symbolic factorisation) for `gaps`.
-    pub fn new(energy: &RodEnergy, gaps: &[&Gap]) -> Self {
-        let map = energy.map;
-        let n = energy.model.segments;
-        let contacts: Vec<Vec<usize>> = gaps.iter().map(|g| contact_nodes(g)).collect();
-        let mut stencils: Vec<Vec<Option<usize>>> = (1..=n)
-            .map(|i| map.vertex_stencil(i).to_vec())
-            .chain((1..n).map(|j| map.edge_stencil(j).to_vec()))
-            .collect();
-        for nodes in &contacts {
-            stencils.push(nodes.iter().flat_map(|&k| node_dofs(energy, k)).collect());
-        }
-        let pattern = SymmetricPattern::from_stencils(map.len(), &stencils);
-        let old = &energy.pattern.matrix;
-        let mut energy_slots = Vec::with_capacity(old.nnz());
-        for c in 0..old.ncols() {
-            for &r in &old.row_indices()[old.col_offsets()[c]..old.col_offsets()[c + 1]] {
-                energy_slots.push(pattern.slot(r, c).expect("widened pattern holds the old"));
-            }
-        }
-        let ldlt = Ldlt::new(&pattern);
-        Widened {
-            values: vec![0.0; pattern.nnz()],
-            pattern,
-            ldlt,
-            contacts,
-            energy_slots,
-        }
-    }
-
-    /// Whether this pattern was built for exactly these contacts.
-    pub fn fits(&self, gaps: &[&Gap]) -> bool {
-        self.contacts.len() == gaps.len()
-            && self
-                .contacts
-                .iter()
-                .zip(gaps)
-                .all(|(c, g)| *c == contact_nodes(g))
-    }
-
-    /// Fill with the energy Hessian `values` and the contacts' terms; the
-    /// contacts `(gap, force)` are those it was built for, in order.
-    pub fn fill<'g>(
-        &mut self,
-        energy: &RodEnergy,
-        values: &[f64],
-        model: &ContactModel,
-        state: &RodState,
-        contacts: impl Iterator<Item = (&'g Gap, f64)>,
-        rho: f64,
-    ) {
-        self.values.iter_mut().for_each(|v| *v = 0.0);
-        for (&slot, v) in self.energy_slots.iter().zip(values) {
-            self.values[slot] += v;
-        }
-        let (points, _) = state.centreline();
-        for (g, z) in contacts {
-            let local: Vec<Option<usize>> = contact_nodes(g)
-                .into_iter()
-                .flat_map(|k| node_dofs(energy, k))
-                .collect();
-            let curvature = (z > 0.0).then(|| gap_hessian(&model.pair_points(&points, g)));
-            let gradient: Vec<f64> = g
-                .gradient
-                .iter()
-                .flat_map(|(_, v)| [v.x, v.y, v.z])
-                .collect();
-            for (a, da) in local.iter().enumerate() {
-                for (b, db) in local.iter().enumerate() {
-                    let (Some(da), Some(db)) = (da, db) else {
-                        continue;
-                    };
-                    if da > db {
-                        continue;
-                    }
-                    let mut v = 0.0;
-                    if let Some(h) = &curvature {
-                        v -= z * h[a][b];
-                    }
-                    if rho > 0.0 {
-                        v += rho * gradient[a] * gradient[b];
-                    }
-                    let slot = self
-                        .pattern
-                        .slot(*da, *db)
-                        .expect("contact stencil in pattern");
-                    self.values[slot] += v;
-                }
-            }
-        }
-    }
-}
-
-/// The 3 translational dofs of node k (None where it is clamped).
-fn node_dofs(energy: &RodEnergy, k: usize) -> [Option<usize>; 3] {
-    match energy.map.node(k) {
-        Some(d) => [Some(d), Some(d + 1), Some(d + 2)],
-        None => [None; 3],
-    }
-}
-
-/// A contact force of an equilibrium.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct ContactForce {
-    /// Arc length on the rod.
-    pub s: f64,
-    /// What it touches ("ray_bottom", "ray_top", "obstacle_k", "self").
-    pub obstacle: String,
-    /// Magnitude of the normal force (the multiplier of gap ≥ 0), in units
-    /// of B/L².
-    pub force: f64,
-    /// Gap (distance − h) there: 0 in contact, to solver tolerance.
-    pub gap: f64,
-}
-
 /// Contact rows of one iterate: candidate gaps and their gradients on the
 /// free dofs (row-major, sparse).
-fn contact_rows(newton: &Newton, state: &RodState) -> (Vec<Gap>, Vec<Vec<(usize, f64)>>) {
-    let Some(model) = &newton.contact else {
+fn contact_rows(
+    energy: &RodEnergy,
+    contact: Option<&ContactModel>,
+    state: &RodState,
+) -> (Vec<Gap>, Vec<Vec<(usize, f64)>>) {
+    let Some(model) = contact else {
         return (Vec::new(), Vec::new());
     };
-    let map = newton.energy.map;
+    let map = energy.map;
     let gaps = model.gaps(state);
     let rows = gaps
         .iter()
@@ -297,21 +147,23 @@ fn contact_rows(newton: &Newton, state: &RodState) -> (Vec<Gap>, Vec<Vec<(usize,
 /// law, contact inequalities) from `state` (updated in place, with its
 /// multipliers).
 pub fn minimize(
-    newton: &mut Newton,
+    energy: &RodEnergy,
+    ldlt: &mut Ldlt,
+    contact: Option<&ContactModel>,
     state: &mut RodState,
-    settings: &NewtonSettings,
-) -> Result<NewtonReport, SolveError> {
-    let map = newton.energy.map;
+    settings: &SolverSettings,
+) -> Result<SolveReport, SolveError> {
+    let map = energy.map;
     let n = map.len();
-    let h = newton.energy.model.segment_length();
-    let constrained = newton.energy.penalty.is_some();
-    let penalty = newton.energy.penalty.unwrap_or(0.0);
-    let segments = newton.energy.model.segments;
+    let h = energy.model.segment_length();
+    let constrained = energy.penalty.is_some();
+    let penalty = energy.penalty.unwrap_or(0.0);
+    let segments = energy.model.segments;
     if constrained {
         state.multipliers.resize(segments + 1, 0.0);
     }
     let m_eq = if constrained { segments } else { 0 };
-    let nnz = newton.energy.pattern.nnz();
+    let nnz = energy.pattern.nnz();
     let mut grad = vec![0.0; n];
     let mut values = vec![0.0; nnz];
     let mut jtc = vec![0.0; n];
@@ -323,31 +175,31 @@ pub fn minimize(
     let mut trial_step = vec![0.0; n];
     let mut part = vec![0.0; n];
     let mut sub = state.clone();
-    let mut jacobian = ConstraintMatrix::new(newton);
-    let mut kkt = constrained.then(|| Kkt::new(&newton.energy));
-    let step_cap = match &newton.contact {
+    let mut jacobian = ConstraintMatrix::new(energy);
+    let mut kkt = constrained.then(|| Kkt::new(&energy));
+    let step_cap = match &contact {
         Some(c) => settings.max_step.min(0.5 * c.margin),
         None => settings.max_step,
     };
     let mut solver: Option<DefaultSolver<f64>> = None;
     // the widened Hessian of the last contact set (pattern and symbolic
     // factorisation reused while the set is unchanged)
-    let mut wide: Option<Widened> = None;
-    let mut report = NewtonReport::start();
+    let mut wide: Option<ContactHessian> = None;
+    let mut report = SolveReport::start();
     let mut trial = state.clone();
     let mut shift;
     // contact forces of the last QP, by (segments, obstacle kind)
     let mut forces: Vec<(Gap, f64)> = Vec::new();
     for it in 0..=settings.max_iterations {
-        let info = newton.energy.hessian(state, &mut grad, &mut values);
+        let info = energy.hessian(state, &mut grad, &mut values);
         let rows = if constrained {
-            newton.energy.constraint_rows(state)
+            energy.constraint_rows(state)
         } else {
             Vec::new()
         };
         let c: Vec<f64> = rows.iter().map(|r| r.0).collect();
         jacobian.fill(&rows);
-        let (gaps, gap_rows) = contact_rows(newton, state);
+        let (gaps, gap_rows) = contact_rows(energy, contact, state);
         // Lagrangian gradient ∇E + Jᵀλ − Σ z ∇g = ∇(augmented) − ρ Jᵀc − Σ z ∇g
         lagrangian.copy_from_slice(&grad);
         if constrained {
@@ -365,8 +217,7 @@ pub fn minimize(
             }
         }
         let gnorm = lagrangian.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let max_diag = newton
-            .energy
+        let max_diag = energy
             .pattern
             .diagonal
             .iter()
@@ -382,8 +233,7 @@ pub fn minimize(
             });
         }
         report.record(it, rel.max(infeasibility), info.energy);
-        let contact_ok = newton
-            .contact
+        let contact_ok = contact
             .as_ref()
             .is_none_or(|m| penetration <= 1e-6 * m.diameter);
         // with contacts the KKT residual stalls near 1e-8: the closest points
@@ -423,11 +273,11 @@ pub fn minimize(
         // with contacts the QP's Hessian is that of the Lagrangian E − Σ z g
         // (the contacts' curvature, forces from the last QP), on the energy's
         // pattern widened by the contact couplings
-        let widened = match &newton.contact {
+        let widened = match &contact {
             Some(model) if !gaps.is_empty() => {
                 let refs: Vec<&Gap> = gaps.iter().collect();
                 if !wide.as_ref().is_some_and(|w| w.fits(&refs)) {
-                    wide = Some(Widened::new(&newton.energy, &refs));
+                    wide = Some(ContactHessian::new(&energy, &refs));
                 }
                 let z = |g: &Gap| {
                     forces
@@ -437,7 +287,7 @@ pub fn minimize(
                 };
                 let w = wide.as_mut().expect("built above");
                 w.fill(
-                    &newton.energy,
+                    &energy,
                     &values,
                     model,
                     state,
@@ -450,7 +300,7 @@ pub fn minimize(
         };
         let (pat, vals, ldlt): (&SymmetricPattern, &mut Vec<f64>, &mut Ldlt) = match wide.as_mut() {
             Some(w) if widened => (&w.pattern, &mut w.values, &mut w.ldlt),
-            _ => (&newton.energy.pattern, &mut values, &mut newton.ldlt),
+            _ => (&energy.pattern, &mut values, ldlt),
         };
         // convexify: W + shift I positive definite, the shift just beyond the
         // lowest eigenvalue (a larger one would make a falling rod creep)
@@ -467,7 +317,7 @@ pub fn minimize(
                 vals[s] -= shift;
             }
             shift = if shift == 0.0 {
-                let lowest = crate::linalg::eigen::lowest_eigenvalues(pat, vals, None, 1, ldlt)
+                let lowest = lowest_eigenvalues(pat, vals, None, 1, ldlt)
                     .ok()
                     .and_then(|sp| sp.values.first().copied())
                     .unwrap_or(-1e-8 * max_diag);
@@ -602,7 +452,7 @@ pub fn minimize(
         }
         let mu = 2.0 * z.iter().fold(0.0f64, |a, b| a.max(*b)) + 1.0;
         let contact_penalty = |s: &RodState| -> f64 {
-            match &newton.contact {
+            match &contact {
                 Some(m) if !gaps.is_empty() => {
                     let (points, _) = s.centreline();
                     gaps.iter()
@@ -613,7 +463,7 @@ pub fn minimize(
                 _ => 0.0,
             }
         };
-        let merit_info = newton.energy.gradient(state, &mut grad);
+        let merit_info = energy.gradient(state, &mut grad);
         let merit0 = merit_info.energy + contact_penalty(state);
         let violation = mu * gaps.iter().map(|g| (-g.gap).max(0.0)).sum::<f64>();
         let slope: f64 = step.iter().zip(&grad).map(|(s, g)| s * g).sum::<f64>() - violation;
@@ -625,7 +475,6 @@ pub fn minimize(
                 residual: rel,
             });
         }
-        let energy = &newton.energy;
         let mut merit_at = |alpha: f64| {
             for (t, v) in trial_step.iter_mut().zip(&step) {
                 *t = alpha * v;
@@ -634,7 +483,7 @@ pub fn minimize(
             // continuous collision check: no candidate pair may pass through
             // contact along the step (sub-steps finer than half a diameter;
             // pairs beyond the margin cannot close it in one step)
-            if let Some(m) = &newton.contact
+            if let Some(m) = &contact
                 && !gaps.is_empty()
             {
                 let largest_move = alpha * largest.min(step_cap);

@@ -3,9 +3,9 @@
 //! strands passing through each other at c1, c2 are the knot changes of a
 //! continuation) and by the paper's asymptotics.
 
+use crate::scene::Scene;
 use crate::study::branch::Event;
 use crate::study::run::run_scene;
-use crate::scene::Scene;
 use anyhow::{Context, Result, bail};
 use std::f64::consts::PI;
 

@@ -6,7 +6,8 @@
 use crate::analysis::equilibrium::{Equilibrium, Measure, Shape, analyse_from};
 use crate::model::rod::{Parameter, RodState};
 use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
-use crate::solve::newton::{Newton, NewtonReport};
+use crate::solve::minimizer::Minimizer;
+use crate::solve::outcome::SolveReport;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
@@ -125,7 +126,7 @@ fn event(kind: &str, p: &Point, branch: usize, detail: String) -> Event {
 impl<'a, 'r> BranchRun<'a, 'r> {
     /// A run on `newton`'s rod; branches are numbered from `first_branch`.
     pub fn new(
-        newton: &'a mut Newton,
+        newton: &'a mut Minimizer,
         options: BranchOptions,
         observer: &'r mut Observer<'r>,
         first_branch: usize,
@@ -143,7 +144,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
 
     fn measure(&mut self, p: &Point, branch: usize, leg: usize) -> Result<Equilibrium> {
         let energy = self.tracer.newton.energy.energy(&p.state);
-        let report = NewtonReport {
+        let report = SolveReport {
             converged: true,
             iterations: p.iterations,
             residual_history: vec![p.residual],

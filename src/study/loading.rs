@@ -4,12 +4,13 @@
 //! being a minimum the rod jumps: the jump is detected (loss of stability of
 //! the carried state, large change of shape or of link) and recorded.
 
-use crate::study::branch::{Event, Observer};
 use crate::analysis::equilibrium::{Measure, analyse, analyse_from};
+use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::rod::{Clamps, RodState};
 use crate::scene::LoadingSpec;
-use crate::solve::newton::{Newton, NewtonSettings};
-use crate::linalg::eigen::lowest_eigenvalues;
+use crate::solve::minimizer::Minimizer;
+use crate::solve::outcome::SolverSettings;
+use crate::study::branch::{Event, Observer};
 use anyhow::{Context, Result, bail};
 
 /// A step is a jump when the minimiser lands farther than this (rod lengths)
@@ -20,7 +21,7 @@ pub const JUMP_DISPLACEMENT: f64 = 0.02;
 pub const JUMP_LINK: f64 = 0.5;
 
 /// Negative eigenvalue count and lowest mode of the Hessian at `state`.
-fn inertia(newton: &mut Newton, state: &RodState, want_mode: bool) -> Result<(usize, Vec<f64>)> {
+fn inertia(newton: &mut Minimizer, state: &RodState, want_mode: bool) -> Result<(usize, Vec<f64>)> {
     let e = &newton.energy;
     let mut g = vec![0.0; e.map.len()];
     let mut v = vec![0.0; e.pattern.nnz()];
@@ -41,10 +42,10 @@ fn inertia(newton: &mut Newton, state: &RodState, want_mode: bool) -> Result<(us
 /// Minimise from `state` and make sure the result is a minimum: from a saddle,
 /// step off along the unstable mode (both ways tried, the lower energy kept).
 pub fn settle(
-    newton: &mut Newton,
+    newton: &mut Minimizer,
     state: &mut RodState,
-    settings: &NewtonSettings,
-) -> Result<crate::solve::newton::NewtonReport> {
+    settings: &SolverSettings,
+) -> Result<crate::solve::outcome::SolveReport> {
     let mut report = newton.minimize(state, settings)?;
     for _ in 0..=8 {
         // held by contacts, it is a minimum of the constrained problem (its
@@ -64,7 +65,7 @@ pub fn settle(
         if largest == 0.0 {
             bail!("saddle with no translational unstable mode");
         }
-        let mut best: Option<(f64, RodState, crate::solve::newton::NewtonReport)> = None;
+        let mut best: Option<(f64, RodState, crate::solve::outcome::SolveReport)> = None;
         for sign in [1.0, -1.0] {
             let kick: Vec<f64> = mode.iter().map(|x| sign * 1e-3 * x / largest).collect();
             let mut trial = state.displaced(&map, &kick);
@@ -95,7 +96,7 @@ fn eq_clamps(eq: &crate::analysis::equilibrium::Equilibrium) -> Clamps {
 
 /// The equilibrium `state` moved to clamps `c` along its tangent (first order
 /// in the clamp move); just the moved clamp if the Hessian is not definite.
-fn predict(newton: &mut Newton, state: &RodState, c: Clamps) -> Result<RodState> {
+fn predict(newton: &mut Minimizer, state: &RodState, c: Clamps) -> Result<RodState> {
     let e = &newton.energy;
     let n = e.map.len();
     let mut g = vec![0.0; n];
@@ -133,7 +134,7 @@ pub struct Step {
     /// The settled state.
     pub state: RodState,
     /// How the minimiser got there.
-    pub report: crate::solve::newton::NewtonReport,
+    pub report: crate::solve::outcome::SolveReport,
     /// Distance from the first-order prediction.
     pub miss: f64,
     /// Whether it landed far from the prediction.
@@ -144,10 +145,10 @@ pub struct Step {
 /// prediction along the branch (dq = −H⁻¹ ∂_p∇E), then minimisation. A smooth
 /// branch lands within second order of the prediction; a jump lands far away.
 pub fn carry(
-    newton: &mut Newton,
+    newton: &mut Minimizer,
     state: &RodState,
     c: Clamps,
-    settings: &NewtonSettings,
+    settings: &SolverSettings,
 ) -> Result<Step> {
     let predicted = predict(newton, state, c)?;
     let predicted_move = max_move(&predicted, state);
@@ -166,11 +167,11 @@ pub fn carry(
 /// `to` (where it fails) down to [`JUMP_LOCATION`]: the last state where it
 /// holds and the first clamps where it fails.
 fn locate_on_path(
-    newton: &mut Newton,
+    newton: &mut Minimizer,
     from: &RodState,
     to: Clamps,
-    settings: &NewtonSettings,
-    same: &mut dyn FnMut(&mut Newton, &Step) -> Result<bool>,
+    settings: &SolverSettings,
+    same: &mut dyn FnMut(&mut Minimizer, &Step) -> Result<bool>,
 ) -> Result<(RodState, Clamps)> {
     let (mut lo, mut hi) = (from.clone(), to);
     while clamp_gap(&lo.clamps, &hi) > JUMP_LOCATION {
@@ -191,7 +192,10 @@ fn path_event(kind: &str, c: &Clamps, twist: f64, leg: usize, detail: String) ->
 }
 
 /// Link change between two equilibria beyond the clamp's own turn.
-fn link_jump(a: &crate::analysis::equilibrium::Equilibrium, b: &crate::analysis::equilibrium::Equilibrium) -> f64 {
+fn link_jump(
+    a: &crate::analysis::equilibrium::Equilibrium,
+    b: &crate::analysis::equilibrium::Equilibrium,
+) -> f64 {
     b.link - a.link - (eq_clamps(b).phi - eq_clamps(a).phi) / (2.0 * std::f64::consts::PI)
 }
 
@@ -214,10 +218,10 @@ fn midpoint(a: &Clamps, b: &Clamps) -> Clamps {
 /// Run the loading path from `state` (an equilibrium at its clamps): every
 /// equilibrium goes to `observer`; returns the jumps.
 pub fn run_loading(
-    newton: &mut Newton,
+    newton: &mut Minimizer,
     mut state: RodState,
     path: &[LoadingSpec],
-    settings: &NewtonSettings,
+    settings: &SolverSettings,
     measure: &Measure,
     observer: &mut Observer<'_>,
 ) -> Result<Vec<Event>> {

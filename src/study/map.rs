@@ -6,12 +6,12 @@
 //! the boundary curves. Maps shard (`--shard i/n`, `knotrod merge`) and resume
 //! from the lines already written.
 
-use crate::study::branch::{BranchOptions, BranchRun, Event};
 use crate::analysis::equilibrium::{Equilibrium, Measure};
-use crate::study::start::starting_equilibrium;
 use crate::model::rod::Parameter;
-use crate::study::run::reach;
 use crate::scene::Scene;
+use crate::study::branch::{BranchOptions, BranchRun, Event};
+use crate::study::run::reach;
+use crate::study::start::starting_equilibrium;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

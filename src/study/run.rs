@@ -1,21 +1,21 @@
 //! Running a scene: one equilibrium, or branches of equilibria (continuation,
 //! optionally swept over a second parameter).
 
-use crate::study::branch::{BranchOptions, BranchRun, Event, Observer, label_events};
 use crate::analysis::equilibrium::{Measure, analyse};
-use crate::study::start::starting_equilibrium;
-use crate::study::loading::run_loading;
 use crate::model::rod::{Parameter, RodState};
 use crate::scene::{Direction, Scene};
 use crate::solve::continuation::{ContinuationSettings, Point, Tracer};
-use crate::solve::newton::Newton;
+use crate::solve::minimizer::Minimizer;
+use crate::study::branch::{BranchOptions, BranchRun, Event, Observer, label_events};
+use crate::study::loading::run_loading;
+use crate::study::start::starting_equilibrium;
 use anyhow::{Context, Result, bail};
 
 /// Move an equilibrium to `parameter = target` by continuation in that
 /// parameter (through folds if need be), ending with a Newton solve at exactly
 /// the target.
 pub fn reach(
-    newton: &mut Newton,
+    newton: &mut Minimizer,
     state: RodState,
     parameter: Parameter,
     target: f64,

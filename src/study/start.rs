@@ -2,11 +2,12 @@
 //! double ring, trefoil, or a restart state) relaxed by the minimiser.
 
 use crate::analysis::equilibrium::{Equilibrium, Measure, Shape, analyse};
+use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
-use crate::model::energy::RodEnergy;
 use crate::scene::{InitialShape, Scene};
-use crate::solve::newton::{Newton, NewtonReport};
+use crate::solve::minimizer::Minimizer;
+use crate::solve::outcome::SolveReport;
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 
@@ -16,8 +17,8 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
     let n = model.segments;
     let init = &scene.initial;
     if let Some(path) = &init.from_recording {
-        let msg =
-            crate::io::recording::read_state(path, init.index as u64).context("initial.from_recording")?;
+        let msg = crate::io::recording::read_state(path, init.index as u64)
+            .context("initial.from_recording")?;
         let mut state = msg.state;
         if state.segments() != n {
             bail!(
@@ -139,13 +140,13 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
 }
 
 /// The scene's starting equilibrium at N segments (the scene's if None): its
-/// initial shape relaxed by Newton, with the minimiser that found it.
+/// initial shape relaxed by the minimiser, with the minimiser that found it.
 pub fn starting_equilibrium(
     scene: &Scene,
     segments: Option<usize>,
-) -> Result<(Newton, RodState, NewtonReport)> {
+) -> Result<(Minimizer, RodState, SolveReport)> {
     let model = scene.rod_model(segments);
-    let mut newton = Newton::new(RodEnergy::new(model.clone()));
+    let mut newton = Minimizer::new(RodEnergy::new(model.clone()));
     newton.contact = scene.contact_model();
     if scene.initial.shape == InitialShape::DoubleRing {
         // unfold the double ring quasi-statically: straight from its own

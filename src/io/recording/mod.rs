@@ -4,10 +4,10 @@
 //! plots, the full state for exact restarts, the events, and metadata. And the
 //! way back: reading states, scalars and events from a recording.
 
-use crate::study::branch::Event;
 use crate::analysis::equilibrium::Equilibrium;
-use crate::model::rod::{RodModel, RodState};
 use crate::io::plot::class_colour;
+use crate::model::rod::{RodModel, RodState};
+use crate::study::branch::Event;
 use anyhow::{Context, Result, anyhow, bail};
 use foxglove::Encode;
 use foxglove::messages::{

@@ -1,17 +1,18 @@
 //! The validation report: every number in docs/validation.md is computed here
 //! (`knotrod validate > docs/validation.md`), never typed by hand.
 
-use crate::report::analytic::{euler_buckling_load, greenhill_constant, greenhill_twisting_moment};
 use crate::analysis::equilibrium::Equilibrium;
-use crate::study::start::solve_scene;
 use crate::geometry::closure::ray_closure;
 use crate::geometry::writhe::writhe_closed;
+use crate::io::summary::relative_deviation;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
+use crate::report::analytic::{euler_buckling_load, greenhill_constant, greenhill_twisting_moment};
 use crate::scene::{InitialShape, Scene};
-use crate::solve::newton::{Newton, NewtonSettings};
-use crate::io::summary::relative_deviation;
+use crate::solve::minimizer::Minimizer;
+use crate::solve::outcome::SolverSettings;
+use crate::study::start::solve_scene;
 use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
@@ -258,9 +259,9 @@ fn analytic_tables() -> Result<String> {
             stretching_stiffness: 640_000.0,
             law: Default::default(),
         };
-        let mut newton = Newton::new(RodEnergy::new(model));
+        let mut newton = Minimizer::new(RodEnergy::new(model));
         let mut st = RodState::straight(n, Clamps::new(1.0, 0.0, f));
-        newton.minimize(&mut st, &NewtonSettings::default())?;
+        newton.minimize(&mut st, &SolverSettings::default())?;
         let phi = 2.0 * PI * f;
         writeln!(
             s,
@@ -799,7 +800,8 @@ fn double_ring_table() -> Result<String> {
             let mut v = vec![0.0; energy.pattern.nnz()];
             energy.hessian(&ring, &mut g, &mut v);
             let mut ldlt = crate::linalg::sparse::Ldlt::new(&energy.pattern);
-            let sp = crate::linalg::eigen::lowest_eigenvalues(&energy.pattern, &v, None, 1, &mut ldlt)?;
+            let sp =
+                crate::linalg::eigen::lowest_eigenvalues(&energy.pattern, &v, None, 1, &mut ldlt)?;
             Ok(sp.values[0])
         };
         let (mut lo, mut hi) = (1.5, 2.5);
@@ -818,7 +820,9 @@ fn double_ring_table() -> Result<String> {
 }
 
 fn asymptotics_table() -> Result<String> {
-    use crate::study::asymptotics::{curve_i, curve_ii, max_one_contact_z_star, one_contact_shifts};
+    use crate::study::asymptotics::{
+        curve_i, curve_ii, max_one_contact_z_star, one_contact_shifts,
+    };
     let mut s = String::new();
     writeln!(
         s,
@@ -865,7 +869,8 @@ fn map3_table(scenes: &Path) -> Result<String> {
             std::env::temp_dir().join(format!("knotrod-validate-fig9-{}-{k}", std::process::id()));
         let idx: Vec<usize> = (0..sspec.lines).collect();
         let lines = crate::study::map::compute_lines(&slice, &sspec, &idx, None, &cache, &|_| {})?;
-        let traced = crate::study::boundary::trace_cached(&slice, &sspec, None, &cache, &|_, _| {})?;
+        let traced =
+            crate::study::boundary::trace_cached(&slice, &sspec, None, &cache, &|_, _| {})?;
         let _ = std::fs::remove_dir_all(&cache);
         maps.push(crate::study::map::assemble(
             "fig9",

@@ -26,9 +26,9 @@ mod walk;
 
 pub use condition::{Condition, Other, Strands};
 
-use crate::study::map::{Line, MapSpec};
 use crate::model::rod::Parameter;
 use crate::scene::Scene;
+use crate::study::map::{Line, MapSpec};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

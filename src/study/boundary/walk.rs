@@ -5,12 +5,12 @@
 use super::condition::{Condition, Failure, Other, Strands, closest_strands, strand_distance};
 use super::{Traced, Trail, finish};
 use crate::analysis::equilibrium::Measure;
-use crate::study::start::starting_equilibrium;
 use crate::geometry::closure::closure_knot;
-use crate::study::map::MapSpec;
 use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
+use crate::study::map::MapSpec;
+use crate::study::start::starting_equilibrium;
 use anyhow::{Context, Result, bail};
 
 #[derive(Clone)]
