@@ -251,12 +251,7 @@ fn hold_contacts(
         return None;
     }
     let energy = &newton.energy;
-    let max_diag = energy
-        .pattern
-        .diagonal
-        .iter()
-        .map(|&s| values[s].abs())
-        .fold(0.0, f64::max);
+    let max_diag = energy.pattern.max_abs_diagonal(values);
     let gaps: Vec<&crate::model::contact::Gap> = held.iter().map(|(g, _)| g).collect();
     let mut wide = ContactHessian::new(energy, &gaps);
     wide.fill(

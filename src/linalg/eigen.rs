@@ -258,12 +258,7 @@ pub fn lowest_eigenvalues(
     let count = |sigma: f64, ldlt: &mut Ldlt, work: &mut Vec<f64>| {
         inertia_at(pattern, values, mass, sigma, ldlt, work).map(|c| c.saturating_sub(massless_neg))
     };
-    let diag_scale = pattern
-        .diagonal
-        .iter()
-        .map(|&s| values[s].abs())
-        .fold(0.0, f64::max)
-        .max(1e-300);
+    let diag_scale = pattern.max_abs_diagonal(values).max(1e-300);
     let negative_count = match count(0.0, ldlt, &mut work) {
         Some(c) => c,
         // singular at 0: count at a tiny negative shift (zero modes are not negative)

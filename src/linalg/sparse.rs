@@ -112,6 +112,15 @@ impl SymmetricPattern {
         }
     }
 
+    /// Largest |A_ii| of the matrix with these values (the scale of its
+    /// stiffness: shifts and round-off floors are measured against it).
+    pub fn max_abs_diagonal(&self, values: &[f64]) -> f64 {
+        self.diagonal
+            .iter()
+            .map(|&s| values[s].abs())
+            .fold(0.0, f64::max)
+    }
+
     /// Dense copy of the symmetric matrix (tests and small diagnostics only).
     pub fn to_dense(&self, values: &[f64]) -> nalgebra::DMatrix<f64> {
         let n = self.dim();

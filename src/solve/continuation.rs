@@ -205,12 +205,7 @@ impl<'a> Tracer<'a> {
         if !gnorm.is_finite() || self.values.iter().any(|v| !v.is_finite()) {
             return Err(ContinuationError::NonFinite("gradient/Hessian"));
         }
-        let max_diag = energy
-            .pattern
-            .diagonal
-            .iter()
-            .map(|&s| self.values[s].abs())
-            .fold(0.0, f64::max);
+        let max_diag = energy.pattern.max_abs_diagonal(&self.values);
         let (rel, at_floor) = residual(&info, gnorm, max_diag, state, n);
         let factored = match &mut self.kkt {
             Some(k) => k.ldlt.factor(&k.values),

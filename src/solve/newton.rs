@@ -56,12 +56,7 @@ impl Newton {
     }
 
     fn max_diagonal(&self, energy: &RodEnergy) -> f64 {
-        energy
-            .pattern
-            .diagonal
-            .iter()
-            .map(|&s| self.values[s].abs())
-            .fold(0.0, f64::max)
+        energy.pattern.max_abs_diagonal(&self.values)
     }
 
     /// Gradient and Hessian at `state` (into the workspace), the relative

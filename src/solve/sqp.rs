@@ -217,12 +217,7 @@ pub fn minimize(
             }
         }
         let gnorm = lagrangian.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let max_diag = energy
-            .pattern
-            .diagonal
-            .iter()
-            .map(|&s| values[s].abs())
-            .fold(0.0, f64::max);
+        let max_diag = energy.pattern.max_abs_diagonal(&values);
         let (rel, at_floor) = residual(&info, gnorm, max_diag, state, n);
         let infeasibility = c.iter().map(|x| (x / h).abs()).fold(0.0, f64::max);
         let penetration = gaps.iter().map(|g| -g.gap).fold(0.0, f64::max);
