@@ -2,8 +2,8 @@
 //! the trefoil tied around the rays (configurations A → B → C, Figures 3-5).
 
 use knotrod::analysis::equilibrium::Equilibrium;
+use knotrod::analysis::event::{Event, EventKind};
 use knotrod::scene::Scene;
-use knotrod::study::branch::Event;
 use knotrod::study::run::run_scene;
 use knotrod::study::start::solve_scene;
 
@@ -92,7 +92,7 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     // B: the contact force reaches zero at φ/2π ≈ 0.768 and the rod jumps
     let lost = events
         .iter()
-        .find(|e| e.kind == "contact_lost" && e.branch == 0)
+        .find(|e| e.kind == EventKind::ContactLost && e.branch == 0)
         .expect("contact lost on the way up");
     assert!(
         (lost.phi_over_2pi - 0.768).abs() < 0.01,
@@ -102,7 +102,9 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     let jump = events
         .iter()
         .find(|e| {
-            e.kind == "jump" && e.branch == 0 && (e.phi_over_2pi - lost.phi_over_2pi).abs() < 1e-3
+            e.kind == EventKind::Jump
+                && e.branch == 0
+                && (e.phi_over_2pi - lost.phi_over_2pi).abs() < 1e-3
         })
         .expect("a jump at B");
     let _ = jump;
@@ -110,7 +112,7 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     // (contact-free continuation of fig3_kirchhoff at N = 100: 0.77411, 0.81862)
     let walls: Vec<f64> = events
         .iter()
-        .filter(|e| e.kind == "wall" && e.branch == 0)
+        .filter(|e| e.kind == EventKind::Wall && e.branch == 0)
         .map(|e| e.phi_over_2pi)
         .collect();
     assert_eq!(walls.len(), 2, "{events:?}");
@@ -127,7 +129,7 @@ fn trefoil_on_the_rays_a_to_b_to_c() {
     // back down: no jump back to B, but at S (≈ 0.751)
     let down: Vec<&Event> = events
         .iter()
-        .filter(|e| e.kind == "jump" && e.branch == 1)
+        .filter(|e| e.kind == EventKind::Jump && e.branch == 1)
         .collect();
     assert_eq!(down.len(), 1, "{events:?}");
     assert!((down[0].phi_over_2pi - 0.751).abs() < 0.005);

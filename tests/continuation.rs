@@ -2,8 +2,8 @@
 //! paper's Figure 3 branch.
 
 use knotrod::analysis::equilibrium::Equilibrium;
+use knotrod::analysis::event::{Event, EventKind};
 use knotrod::scene::Scene;
-use knotrod::study::branch::Event;
 use knotrod::study::run::run_scene;
 
 fn run(scene: &Scene) -> (Vec<Equilibrium>, Vec<Event>) {
@@ -25,7 +25,10 @@ fn converged_minima_and_jumps<'a>(eqs: &[Equilibrium], events: &'a [Event]) -> V
             e.phi_over_2pi
         );
     }
-    events.iter().filter(|e| e.kind == "jump").collect()
+    events
+        .iter()
+        .filter(|e| e.kind == EventKind::Jump)
+        .collect()
 }
 
 /// A paper scene at another N with extra TOML appended.
@@ -84,7 +87,10 @@ fn appendix_e_fold(step: f64) -> (Vec<Equilibrium>, Vec<Event>) {
 #[test]
 fn continuation_locates_a_fold_and_continues_on_the_unstable_side() {
     let (points, events) = appendix_e_fold(0.005);
-    let fold = events.iter().find(|e| e.kind == "fold").expect("a fold");
+    let fold = events
+        .iter()
+        .find(|e| e.kind == EventKind::Fold)
+        .expect("a fold");
     assert!(fold.detail.contains("0 → 1"), "{fold:?}");
     // the fold is the extreme φ of the branch
     let min_phi = points
@@ -112,7 +118,7 @@ fn continuation_locates_a_fold_and_continues_on_the_unstable_side() {
     let (_, again) = appendix_e_fold(0.0031);
     let fold2 = again
         .iter()
-        .find(|e| e.kind == "fold")
+        .find(|e| e.kind == EventKind::Fold)
         .expect("fold found again");
     assert!(
         (fold.phi_over_2pi - fold2.phi_over_2pi).abs() < 1e-6,
@@ -130,7 +136,7 @@ fn figure_3_events_at_n_200() {
         "[continuation]\nparameter = \"phi\"\nrange = [0.745, 0.99]\ndirection = \"both\"\n",
     );
     let (_, events) = run(&scene);
-    let find = |kind: &str, near: f64| {
+    let find = |kind: EventKind, near: f64| {
         events
             .iter()
             .filter(|e| e.kind == kind && e.branch == 0)
@@ -139,16 +145,19 @@ fn figure_3_events_at_n_200() {
             .unwrap_or_else(|| panic!("no {kind} event: {events:?}"))
     };
     let (w1, w2, x, s) = (
-        find("wall", 0.774),
-        find("wall", 0.82),
-        find("crossing", 0.96),
-        find("branch_point", 0.75),
+        find(EventKind::Wall, 0.774),
+        find(EventKind::Wall, 0.82),
+        find(EventKind::Crossing, 0.96),
+        find(EventKind::BranchPoint, 0.75),
     );
     assert!((w1 - 0.774).abs() < 0.005, "W1 at {w1}");
     assert!((w2 - 0.82).abs() < 0.01, "W2 at {w2}");
     assert!((x - 0.96).abs() < 0.01, "X at {x}");
     assert!(s < w1 && s > 0.745, "S at {s}");
-    let bp = events.iter().find(|e| e.kind == "branch_point").unwrap();
+    let bp = events
+        .iter()
+        .find(|e| e.kind == EventKind::BranchPoint)
+        .unwrap();
     assert!(
         bp.detail.starts_with("negative eigenvalues 0 → 1"),
         "{bp:?}"
@@ -164,7 +173,7 @@ fn two_mirror_branches_leave_the_pitchfork() {
     );
     let (eqs, events) = run(&scene);
     assert!(
-        events.iter().any(|e| e.kind == "branch_point"),
+        events.iter().any(|e| e.kind == EventKind::BranchPoint),
         "{events:?}"
     );
     let branch = |b: usize| -> Vec<&Equilibrium> { eqs.iter().filter(|e| e.branch == b).collect() };
@@ -256,7 +265,7 @@ fn twisting_a_buckled_rod_snaps_at_two_different_angles() {
     assert!((at(0).twist - at(1).twist).abs() > 0.1);
     // jumps are located where the branch ends, not where a step overshoots
     let (_, again) = twist_snap(47, 29);
-    let again: Vec<&Event> = again.iter().filter(|e| e.kind == "jump").collect();
+    let again: Vec<&Event> = again.iter().filter(|e| e.kind == EventKind::Jump).collect();
     assert_eq!(again.len(), 2);
     for (a, b) in [(up, again[0]), (down, again[1])] {
         assert!(

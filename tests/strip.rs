@@ -4,6 +4,7 @@
 //! (paper eq. 2.7); Figure 8.
 
 use knotrod::analysis::equilibrium::Equilibrium;
+use knotrod::analysis::event::{Event, EventKind};
 use knotrod::linalg::eigen::lowest_eigenvalues;
 use knotrod::linalg::sparse::Ldlt;
 use knotrod::model::energy::RodEnergy;
@@ -11,7 +12,6 @@ use knotrod::model::rod::{Law, RodModel, RodState};
 use knotrod::scene::Scene;
 use knotrod::solve::minimizer::Minimizer;
 use knotrod::solve::outcome::SolverSettings;
-use knotrod::study::branch::Event;
 use knotrod::study::run::run_scene;
 use knotrod::study::start::starting_equilibrium;
 use nalgebra::DMatrix;
@@ -220,7 +220,11 @@ fn figure_8_strip_branches_at_n_100() {
             e.z_star, e.phi_over_2pi
         );
     }
-    for kind in ["fold", "branch_point", "stability"] {
+    for kind in [
+        EventKind::Fold,
+        EventKind::BranchPoint,
+        EventKind::Stability,
+    ] {
         assert!(!events.iter().any(|e| e.kind == kind), "{kind}: {events:?}");
     }
     // the five branches cover φ/2π from below 0.5 to 1

@@ -1,6 +1,7 @@
 //! One equilibrium of a scene: initial shape, Newton solve, and the quantities
 //! the paper reports (clamp reactions, twist, walls, stability).
 
+use crate::analysis::class::{good_knot, is_trefoil};
 use crate::geometry::closure::{closure_knot, ray_closure, reach};
 use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
 use crate::geometry::knot::KnotType;
@@ -374,11 +375,14 @@ pub fn analyse_from(
         writhe: shape.writhe,
         link: twist + shape.writhe,
         knot_determinant: shape.knot.determinant,
-        good_knot: walled
-            && shape.knot.determinant == 3
-            && !shape.knot.ambiguous
-            && stable
-            && min_self_distance > measure.rod_diameter,
+        good_knot: good_knot(
+            walled,
+            is_trefoil(shape.knot.determinant),
+            shape.knot.ambiguous,
+            stable,
+            min_self_distance,
+            measure.rod_diameter,
+        ),
         alexander: shape.knot.alexander,
         knot_name: shape.knot.name,
         knot_ambiguous: shape.knot.ambiguous,

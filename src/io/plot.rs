@@ -4,27 +4,32 @@
 //! and the minimum self-distance along the branches. SVG always; PNG when a
 //! TrueType font is found for the labels.
 
+use crate::analysis::class::{Class, is_trefoil};
 use crate::analysis::equilibrium::Equilibrium;
-use crate::study::branch::Event;
+use crate::analysis::event::Event;
 use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// The paper's colour classes.
+/// The colour of an equilibrium's class (summaries' good knot).
 pub fn class_colour(e: &Equilibrium) -> RGBColor {
-    colour_of(e.stable, e.knot_determinant, e.good_knot)
+    colour_of(Class::of(
+        e.stable,
+        is_trefoil(e.knot_determinant),
+        e.good_knot,
+    ))
 }
 
-fn colour_of(stable: bool, knot_determinant: u64, good_knot: bool) -> RGBColor {
-    if !stable {
-        RGBColor(210, 40, 40) // red: unstable
-    } else if knot_determinant != 3 {
-        RGBColor(150, 95, 40) // brown: unknotted
-    } else if good_knot {
-        RGBColor(40, 160, 60) // green: good knot
-    } else {
-        RGBColor(40, 90, 200) // blue: stable, knotted, not walled (or touching)
+/// The paper's colour of a class.
+pub fn colour_of(class: Class) -> RGBColor {
+    match class {
+        Class::Unstable => RGBColor(210, 40, 40),
+        Class::Unknotted => RGBColor(150, 95, 40),
+        Class::Good => RGBColor(40, 160, 60),
+        // stable, knotted, not walled (or touching); no point: white
+        Class::StableUnwalled => RGBColor(40, 90, 200),
+        Class::None => RGBColor(255, 255, 255),
     }
 }
 
@@ -70,7 +75,11 @@ impl From<&crate::io::recording::Scalars> for PlotPoint {
             phi_over_2pi: e.phi_over_2pi,
             twist: e.twist,
             stable: e.stable,
-            colour: colour_of(e.stable, e.knot_determinant, e.good_knot),
+            colour: colour_of(Class::of(
+                e.stable,
+                is_trefoil(e.knot_determinant),
+                e.good_knot,
+            )),
             omega_squared: Some(e.lowest_omega_squared).filter(|v| v.is_finite()),
             min_self_distance: e.min_self_distance,
             branch: e.branch,
@@ -355,7 +364,6 @@ fn draw_map<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    use crate::study::map::Class;
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plot: {e:?}");
     root.fill(&WHITE).map_err(err)?;
     let (x0, x1) = bounds(&map.grid_phi);
@@ -376,13 +384,10 @@ where
         .map_err(err)?;
     for (row, l) in map.grid.iter().zip(&map.lines) {
         for (c, phi) in row.iter().zip(&map.grid_phi) {
-            let col = match c {
-                Class::Good => RGBColor(40, 160, 60),
-                Class::StableUnwalled => RGBColor(40, 90, 200),
-                Class::Unknotted => RGBColor(150, 95, 40),
-                Class::Unstable => RGBColor(210, 40, 40),
-                Class::None => continue,
-            };
+            if *c == Class::None {
+                continue;
+            }
+            let col = colour_of(*c);
             chart
                 .draw_series(std::iter::once(Circle::new(
                     (*phi, l.value),

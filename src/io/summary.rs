@@ -1,9 +1,9 @@
 //! The machine-readable run summary (JSON) and its human-readable print.
 
 use crate::analysis::equilibrium::Equilibrium;
+use crate::analysis::event::Event;
 use crate::model::rod::RodModel;
 use crate::scene::Scene;
-use crate::study::branch::Event;
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::Path;

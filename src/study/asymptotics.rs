@@ -3,8 +3,8 @@
 //! strands passing through each other at c1, c2 are the knot changes of a
 //! continuation) and by the paper's asymptotics.
 
+use crate::analysis::event::{Event, EventKind};
 use crate::scene::Scene;
-use crate::study::branch::Event;
 use crate::study::run::run_scene;
 use anyhow::{Context, Result, bail};
 use std::f64::consts::PI;
@@ -53,7 +53,7 @@ fn crossings(scene: &Scene) -> Result<Vec<Event>> {
     let events = run_scene(scene, None, &mut |_| Ok(()))?;
     Ok(events
         .into_iter()
-        .filter(|e| e.kind == "crossing")
+        .filter(|e| e.kind == EventKind::Crossing)
         .collect())
 }
 

@@ -4,33 +4,13 @@
 //! bifurcating branches followed from branch points when asked.
 
 use crate::analysis::equilibrium::{Equilibrium, Measure, Shape, analyse_from};
+use crate::analysis::event::{Event, EventKind};
 use crate::model::rod::{Parameter, RodState};
 use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-
-/// A located event.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct Event {
-    /// "wall" | "crossing" | "stability" | "fold" | "branch_point" | "jump" | "knot_change" | "end".
-    pub kind: String,
-    /// Label as in the paper's figures (W1, W2, X, S, F1, ...).
-    pub label: String,
-    /// Where.
-    pub phi_over_2pi: f64,
-    /// Where.
-    pub z_star: f64,
-    /// Where.
-    pub delta: f64,
-    /// Twist there (the figures' vertical axis).
-    pub twist: f64,
-    /// Branch it lies on (for a loading path: the leg of the path).
-    pub branch: usize,
-    /// Free text (e.g. negative eigenvalue counts on either side).
-    pub detail: String,
-}
 
 /// Test functions watched along a branch.
 #[derive(Clone, Debug)]
@@ -97,29 +77,7 @@ pub struct BranchRun<'a, 'r> {
     previous: Option<Equilibrium>,
 }
 
-impl Event {
-    /// An event of `kind` at clamps `c`, where the twist is `twist`.
-    pub fn at(
-        kind: &str,
-        c: &crate::model::rod::Clamps,
-        twist: f64,
-        branch: usize,
-        detail: String,
-    ) -> Event {
-        Event {
-            kind: kind.into(),
-            label: String::new(),
-            phi_over_2pi: c.phi_over_2pi(),
-            z_star: c.z_star,
-            delta: c.delta,
-            twist,
-            branch,
-            detail,
-        }
-    }
-}
-
-fn event(kind: &str, p: &Point, branch: usize, detail: String) -> Event {
+fn event(kind: EventKind, p: &Point, branch: usize, detail: String) -> Event {
     Event::at(kind, &p.state.clamps, p.state.twist(), branch, detail)
 }
 
@@ -207,7 +165,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                         Ok(p) if self.in_range(&p) => self.trace(p, b, 0, true)?,
                         Ok(_) => {}
                         Err(e) => self.events.push(event(
-                            "end",
+                            EventKind::End,
                             &bp,
                             b,
                             format!("branch switch failed: {e}"),
@@ -244,7 +202,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                     ds *= 0.5;
                     if ds < settings.min_step {
                         self.events.push(event(
-                            "end",
+                            EventKind::End,
                             &a,
                             branch,
                             "step below min_step: branch lost".into(),
@@ -307,9 +265,10 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 // φ, Tw, walls): a symmetric branch point, not a fold
                 let detail =
                     format!("{detail}; through a symmetric branch point onto the mirror branch");
-                self.events.push(event("branch_point", &p, branch, detail));
+                self.events
+                    .push(event(EventKind::BranchPoint, &p, branch, detail));
             } else {
-                self.events.push(event("fold", &p, branch, detail));
+                self.events.push(event(EventKind::Fold, &p, branch, detail));
             }
         }
         if a.negative_count != b.negative_count {
@@ -319,11 +278,11 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 .context("locating a change of stability")?;
             let detail = format!("negative eigenvalues {} → {}", na, b.negative_count);
             self.events
-                .push(event("stability", &p, branch, detail.clone()));
+                .push(event(EventKind::Stability, &p, branch, detail.clone()));
             if !fold {
                 let (lambda, null) = self.tracer.lowest_mode(&p)?;
                 self.events.push(event(
-                    "branch_point",
+                    EventKind::BranchPoint,
                     &p,
                     branch,
                     format!("{detail}; eigenvalue there {lambda:.2e}"),
@@ -341,7 +300,8 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             } else {
                 "enters the walls"
             };
-            self.events.push(event("wall", &p, branch, detail.into()));
+            self.events
+                .push(event(EventKind::Wall, &p, branch, detail.into()));
         }
         if wa.knot != wb.knot || (wb.link - wa.link).abs() > 1.0 {
             let (ka, la) = (wa.knot, wa.link);
@@ -356,9 +316,10 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 wa.knot, wb.knot, wa.link, wb.link
             );
             self.events
-                .push(event("crossing", &p, branch, detail.clone()));
+                .push(event(EventKind::Crossing, &p, branch, detail.clone()));
             if wa.knot != wb.knot {
-                self.events.push(event("knot_change", &p, branch, detail));
+                self.events
+                    .push(event(EventKind::KnotChange, &p, branch, detail));
             }
         }
         Ok(())
@@ -371,53 +332,5 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         same: &mut dyn FnMut(&mut Tracer<'a>, &Point) -> bool,
     ) -> Result<Point, ContinuationError> {
         self.tracer.locate(from, sigma, same)
-    }
-}
-
-/// Label events as in the paper's figures: walls W1, W2, … by increasing φ on
-/// each branch, S for branch points, F for folds, J for jumps, and X, X2, …
-/// for crossings in the order met from the start of the branch.
-pub fn label_events(events: &mut [Event]) {
-    let mut crossings = std::collections::HashMap::<(usize, u64), usize>::new();
-    for e in events.iter_mut().filter(|e| e.kind == "crossing") {
-        let k = crossings.entry((e.branch, e.z_star.to_bits())).or_insert(0);
-        *k += 1;
-        e.label = if *k == 1 { "X".into() } else { format!("X{k}") };
-    }
-    let mut order: Vec<usize> = (0..events.len()).collect();
-    order.sort_by(|&i, &j| {
-        (
-            events[i].branch,
-            events[i].z_star.to_bits(),
-            events[i].phi_over_2pi,
-        )
-            .partial_cmp(&(
-                events[j].branch,
-                events[j].z_star.to_bits(),
-                events[j].phi_over_2pi,
-            ))
-            .unwrap()
-    });
-    let mut counters = std::collections::HashMap::<(usize, u64, &str), usize>::new();
-    for &i in &order {
-        let prefix = match events[i].kind.as_str() {
-            "wall" => "W",
-            "crossing" => "X",
-            "branch_point" => "S",
-            "fold" => "F",
-            "jump" => "J",
-            _ => continue,
-        };
-        if prefix == "X" {
-            continue;
-        }
-        let key = (events[i].branch, events[i].z_star.to_bits(), prefix);
-        let k = counters.entry(key).or_insert(0);
-        *k += 1;
-        events[i].label = if prefix == "W" || prefix == "F" || prefix == "J" || *k > 1 {
-            format!("{prefix}{k}")
-        } else {
-            prefix.to_string()
-        };
     }
 }

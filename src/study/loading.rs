@@ -5,12 +5,13 @@
 //! the carried state, large change of shape or of link) and recorded.
 
 use crate::analysis::equilibrium::{Measure, analyse, analyse_from};
+use crate::analysis::event::{Event, EventKind};
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::rod::{Clamps, RodState};
 use crate::scene::LoadingSpec;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolverSettings;
-use crate::study::branch::{Event, Observer};
+use crate::study::branch::Observer;
 use anyhow::{Context, Result, bail};
 
 /// A step is a jump when the minimiser lands farther than this (rod lengths)
@@ -187,7 +188,7 @@ fn locate_on_path(
 }
 
 /// An event of a loading path at clamps `c` (its `branch` is the path's leg).
-fn path_event(kind: &str, c: &Clamps, twist: f64, leg: usize, detail: String) -> Event {
+fn path_event(kind: EventKind, c: &Clamps, twist: f64, leg: usize, detail: String) -> Event {
     Event::at(kind, c, twist, leg, detail)
 }
 
@@ -278,7 +279,11 @@ pub fn run_loading(
                     events.push(path_event(
                         // the link changes by ±2 without a jump when the
                         // centreline passes through itself (no contact model)
-                        if landed.jumped { "jump" } else { "crossing" },
+                        if landed.jumped {
+                            EventKind::Jump
+                        } else {
+                            EventKind::Crossing
+                        },
                         &hi,
                         lo_eq.twist,
                         leg,
@@ -310,7 +315,13 @@ pub fn run_loading(
                 } else {
                     "enters the walls"
                 };
-                events.push(path_event("wall", &hi, eq.twist, leg, detail.into()));
+                events.push(path_event(
+                    EventKind::Wall,
+                    &hi,
+                    eq.twist,
+                    leg,
+                    detail.into(),
+                ));
             }
             if !eq.contacts.is_empty() && next.contacts.is_empty() {
                 // the last contact opens: locate where its force reaches zero
@@ -324,7 +335,13 @@ pub fn run_loading(
                     names.join(", "),
                     eq.contact_force
                 );
-                events.push(path_event("contact_lost", &hi, eq.twist, leg, detail));
+                events.push(path_event(
+                    EventKind::ContactLost,
+                    &hi,
+                    eq.twist,
+                    leg,
+                    detail,
+                ));
             }
             observer(next.clone())?;
             state = step.state;

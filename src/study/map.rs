@@ -6,43 +6,18 @@
 //! the boundary curves. Maps shard (`--shard i/n`, `knotrod merge`) and resume
 //! from the lines already written.
 
+use crate::analysis::class::{Class, is_trefoil};
 use crate::analysis::equilibrium::{Equilibrium, Measure};
+use crate::analysis::event::{Event, EventKind};
 use crate::model::rod::Parameter;
 use crate::scene::Scene;
-use crate::study::branch::{BranchOptions, BranchRun, Event};
+use crate::study::branch::{BranchOptions, BranchRun};
 use crate::study::run::reach;
 use crate::study::start::starting_equilibrium;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// Class of a point of the map, as coloured in the paper.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub enum Class {
-    /// Walled, knotted, stable, contact-free.
-    Good,
-    /// Stable and knotted, not walled.
-    StableUnwalled,
-    /// Stable, not knotted.
-    Unknotted,
-    /// Unstable.
-    Unstable,
-    /// No equilibrium of the followed branch there.
-    None,
-}
-
-/// The paper's good knot (its X boundary is the self-crossing, the rod being
-/// thin): stable, walled, trefoil.
-pub fn class_of(stable: bool, walled: bool, knot_determinant: u64) -> Class {
-    match (stable, knot_determinant == 3, walled) {
-        (false, _, _) => Class::Unstable,
-        (true, false, _) => Class::Unknotted,
-        (true, true, true) => Class::Good,
-        (true, true, false) => Class::StableUnwalled,
-    }
-}
 
 /// A point of a line of the map.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -304,8 +279,11 @@ fn boundary_label(events: &[Event], p: &LinePoint, q: &LinePoint, lower: bool) -
         .filter(|e| {
             e.branch == 0
                 && matches!(
-                    e.kind.as_str(),
-                    "wall" | "crossing" | "branch_point" | "fold"
+                    e.kind,
+                    EventKind::Wall
+                        | EventKind::Crossing
+                        | EventKind::BranchPoint
+                        | EventKind::Fold
                 )
         })
         // the event lies on the arc between the two points: near their chord
@@ -313,11 +291,11 @@ fn boundary_label(events: &[Event], p: &LinePoint, q: &LinePoint, lower: bool) -
         .min_by(|x, y| dist(x).total_cmp(&dist(y)));
     match best {
         Some(e) => {
-            let label = match (e.kind.as_str(), lower) {
-                ("wall", true) => "W1",
-                ("wall", false) => "W2",
-                ("crossing", _) => "X",
-                ("fold", _) => "F",
+            let label = match (e.kind, lower) {
+                (EventKind::Wall, true) => "W1",
+                (EventKind::Wall, false) => "W2",
+                (EventKind::Crossing, _) => "X",
+                (EventKind::Fold, _) => "F",
                 _ => "S",
             };
             (e.phi_over_2pi, label.to_string())
@@ -397,7 +375,7 @@ pub fn line(scene: &Scene, spec: &MapSpec, index: usize, segments: Option<usize>
                 .map(|e| LinePoint {
                     phi_over_2pi: e.phi_over_2pi,
                     twist: e.twist,
-                    class: class_of(e.stable, e.walled, e.knot_determinant),
+                    class: Class::of(e.stable, is_trefoil(e.knot_determinant), e.walled),
                 })
                 .collect();
             out.intervals = intervals_of(&out.points, &events);

@@ -2,11 +2,12 @@
 //! optionally swept over a second parameter).
 
 use crate::analysis::equilibrium::{Measure, analyse};
+use crate::analysis::event::{Event, label_events};
 use crate::model::rod::{Parameter, RodState};
 use crate::scene::{Direction, Scene};
 use crate::solve::continuation::{ContinuationSettings, Point, Tracer};
 use crate::solve::minimizer::Minimizer;
-use crate::study::branch::{BranchOptions, BranchRun, Event, Observer, label_events};
+use crate::study::branch::{BranchOptions, BranchRun, Observer};
 use crate::study::loading::run_loading;
 use crate::study::start::starting_equilibrium;
 use anyhow::{Context, Result, bail};

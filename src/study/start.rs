@@ -1,6 +1,7 @@
 //! The starting equilibrium of a scene: its initial shape (straight, shooting,
 //! double ring, trefoil, or a restart state) relaxed by the minimiser.
 
+use crate::analysis::class::is_trefoil;
 use crate::analysis::equilibrium::{Equilibrium, Measure, Shape, analyse};
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
@@ -77,7 +78,7 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
             };
             set(&mut state, 0.0);
             let shape = Shape::of(&state, &Measure::of(scene));
-            if shape.knot.determinant != 3 {
+            if !is_trefoil(shape.knot.determinant) {
                 bail!(
                     "initial.shape = \"trefoil\": at z* = {}, δ = {} the guide curve's ray \
                      closure is not a trefoil (knot determinant {}); start from the \

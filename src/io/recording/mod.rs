@@ -5,9 +5,9 @@
 //! way back: reading states, scalars and events from a recording.
 
 use crate::analysis::equilibrium::Equilibrium;
+use crate::analysis::event::Event;
 use crate::io::plot::class_colour;
 use crate::model::rod::{RodModel, RodState};
-use crate::study::branch::Event;
 use anyhow::{Context, Result, anyhow, bail};
 use foxglove::Encode;
 use foxglove::messages::{

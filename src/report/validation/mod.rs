@@ -2,6 +2,7 @@
 //! (`knotrod validate > docs/validation.md`), never typed by hand.
 
 use crate::analysis::equilibrium::Equilibrium;
+use crate::analysis::event::EventKind;
 use crate::geometry::closure::ray_closure;
 use crate::geometry::writhe::writhe_closed;
 use crate::io::summary::relative_deviation;
@@ -374,7 +375,7 @@ fn writhe_table(scenes: &[&Scene]) -> Result<String> {
 }
 
 /// Events of the Figure 3 branch (main branch, φ/2π in [0.745, 0.99]) at N.
-fn figure_3_events(d: &Scene, n: usize) -> Result<Vec<crate::study::branch::Event>> {
+fn figure_3_events(d: &Scene, n: usize) -> Result<Vec<crate::analysis::event::Event>> {
     let mut scene = d.clone();
     scene.continuation = Some(crate::scene::ContinuationSpec {
         parameter: crate::model::rod::Parameter::Phi,
@@ -392,10 +393,10 @@ fn figure_3_events(d: &Scene, n: usize) -> Result<Vec<crate::study::branch::Even
 fn figure_3_table(d: &Scene) -> Result<String> {
     let mut s = String::new();
     let targets = [
-        ("W1", "wall", 0.774, Some(0.774)),
-        ("W2", "wall", 0.82, Some(0.82)),
-        ("X", "crossing", 0.96, Some(0.96)),
-        ("S", "branch_point", 0.75, None),
+        ("W1", EventKind::Wall, 0.774, Some(0.774)),
+        ("W2", EventKind::Wall, 0.82, Some(0.82)),
+        ("X", EventKind::Crossing, 0.96, Some(0.96)),
+        ("S", EventKind::BranchPoint, 0.75, None),
     ];
     let ns = [100, 200, 400];
     let mut found: Vec<Vec<f64>> = Vec::new();
@@ -668,7 +669,7 @@ fn run_text(
     text: &str,
 ) -> Result<(
     Vec<crate::analysis::equilibrium::Equilibrium>,
-    Vec<crate::study::branch::Event>,
+    Vec<crate::analysis::event::Event>,
 )> {
     let scene = Scene::parse(text)?;
     let mut eqs = Vec::new();
@@ -715,7 +716,7 @@ fn loading_table(scenes: &Path) -> Result<String> {
         let (_, events) = run_text(&text)?;
         let jumps: Vec<f64> = events
             .iter()
-            .filter(|e| e.kind == "jump")
+            .filter(|e| e.kind == EventKind::Jump)
             .map(|e| e.phi_over_2pi)
             .collect();
         writeln!(
@@ -738,7 +739,7 @@ fn strip_table(scenes: &Path) -> Result<String> {
         let (eqs, events) = run_text(&scene_text(scenes, "fig8_strip.toml", Some(n))?)?;
         let folds = events
             .iter()
-            .filter(|e| e.kind == "fold" || e.kind == "branch_point")
+            .filter(|e| e.kind == EventKind::Fold || e.kind == EventKind::BranchPoint)
             .count();
         for z in [0.115, 0.150, 0.180, 0.200, 0.215] {
             let mut pts: Vec<&crate::analysis::equilibrium::Equilibrium> =
@@ -994,7 +995,7 @@ fn contact_table(scenes: &Path) -> Result<String> {
         "| A: min self-distance | {:.4} (h = 0.005) | > h |",
         a.min_self_distance
     )?;
-    let find_with = |kind: &str, leg: usize, detail: &str| {
+    let find_with = |kind: EventKind, leg: usize, detail: &str| {
         events
             .iter()
             .filter(|e| e.kind == kind && e.branch == leg && e.detail.contains(detail))
@@ -1002,7 +1003,7 @@ fn contact_table(scenes: &Path) -> Result<String> {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let find = |kind: &str, leg: usize| {
+    let find = |kind: EventKind, leg: usize| {
         events
             .iter()
             .filter(|e| e.kind == kind && e.branch == leg)
@@ -1013,9 +1014,9 @@ fn contact_table(scenes: &Path) -> Result<String> {
     writeln!(
         s,
         "| B: ray contact force reaches zero (up) | φ/2π = {} | 0.768 |",
-        find_with("contact_lost", 0, "ray")
+        find_with(EventKind::ContactLost, 0, "ray")
     )?;
-    let self_lost = find_with("contact_lost", 0, "self");
+    let self_lost = find_with(EventKind::ContactLost, 0, "self");
     writeln!(
         s,
         "| self-contact lost (up; near X the strands touch instead of crossing) | φ/2π = {} | — (no contact in the paper's X) |",
@@ -1028,17 +1029,17 @@ fn contact_table(scenes: &Path) -> Result<String> {
     writeln!(
         s,
         "| jumps on the way up | φ/2π = {} | at B |",
-        find("jump", 0)
+        find(EventKind::Jump, 0)
     )?;
     writeln!(
         s,
         "| C: walls on the way up (W1, W2) | φ/2π = {} | 0.774, 0.82 |",
-        find("wall", 0)
+        find(EventKind::Wall, 0)
     )?;
     writeln!(
         s,
         "| back down: jumps | φ/2π = {} | at S (no return to B) |",
-        find("jump", 1)
+        find(EventKind::Jump, 1)
     )?;
     Ok(s)
 }

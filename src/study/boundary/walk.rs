@@ -4,6 +4,7 @@
 
 use super::condition::{Condition, Failure, Other, Strands, closest_strands, strand_distance};
 use super::{Traced, Trail, finish};
+use crate::analysis::class::is_trefoil;
 use crate::analysis::equilibrium::Measure;
 use crate::geometry::closure::closure_knot;
 use crate::model::rod::{Clamps, Parameter, RodState};
@@ -217,7 +218,7 @@ impl Walk<'_, '_> {
         if skip != Some(Failure::Stability) && site.point.negative_count > 0 {
             return Ok(Some(Failure::Stability));
         }
-        let trefoil = |s: &RodState| closure_knot(&s.centreline().0).determinant == 3;
+        let trefoil = |s: &RodState| is_trefoil(closure_knot(&s.centreline().0).determinant);
         let knotted = if skip == Some(Failure::Knot) {
             let off = self.settle(site, along(site.p, normal, FD))?;
             trefoil(&off.point.state)

@@ -1,0 +1,146 @@
+//! Events of a path of equilibria (a branch or a loading path): what happens,
+//! where, and the paper's labels (W1, W2, X, S, F1, J1, ...).
+
+use crate::model::rod::Clamps;
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+
+/// What happens at an event (JSON: the snake_case name, e.g. "branch_point").
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq, Hash)]
+#[serde(rename_all = "snake_case")]
+pub enum EventKind {
+    /// The rod touches a wall (enters or leaves the walled region).
+    Wall,
+    /// The centreline passes through itself or a ray (the link jumps by ±2).
+    Crossing,
+    /// The count of negative eigenvalues changes.
+    Stability,
+    /// The parameter turns back along the branch.
+    Fold,
+    /// A branch point: another branch crosses this one.
+    BranchPoint,
+    /// The rod jumps off its branch (loading paths).
+    Jump,
+    /// The knot type of the ray closure changes.
+    KnotChange,
+    /// The branch ends (lost, or a switch failed).
+    End,
+    /// The last contact opens (loading with contact).
+    ContactLost,
+}
+
+impl EventKind {
+    /// The name used in JSON and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            EventKind::Wall => "wall",
+            EventKind::Crossing => "crossing",
+            EventKind::Stability => "stability",
+            EventKind::Fold => "fold",
+            EventKind::BranchPoint => "branch_point",
+            EventKind::Jump => "jump",
+            EventKind::KnotChange => "knot_change",
+            EventKind::End => "end",
+            EventKind::ContactLost => "contact_lost",
+        }
+    }
+
+    /// The letter of the paper's labels, for the kinds the figures label.
+    fn label_prefix(self) -> Option<&'static str> {
+        match self {
+            EventKind::Wall => Some("W"),
+            EventKind::Crossing => Some("X"),
+            EventKind::BranchPoint => Some("S"),
+            EventKind::Fold => Some("F"),
+            EventKind::Jump => Some("J"),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for EventKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // padding and alignment of tables apply to the name
+        f.pad(self.name())
+    }
+}
+
+/// A located event.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Event {
+    /// What happens.
+    pub kind: EventKind,
+    /// Label as in the paper's figures (W1, W2, X, S, F1, ...).
+    pub label: String,
+    /// Where.
+    pub phi_over_2pi: f64,
+    /// Where.
+    pub z_star: f64,
+    /// Where.
+    pub delta: f64,
+    /// Twist there (the figures' vertical axis).
+    pub twist: f64,
+    /// Branch it lies on (for a loading path: the leg of the path).
+    pub branch: usize,
+    /// Free text (e.g. negative eigenvalue counts on either side).
+    pub detail: String,
+}
+
+impl Event {
+    /// An event of `kind` at clamps `c`, where the twist is `twist`.
+    pub fn at(kind: EventKind, c: &Clamps, twist: f64, branch: usize, detail: String) -> Event {
+        Event {
+            kind,
+            label: String::new(),
+            phi_over_2pi: c.phi_over_2pi(),
+            z_star: c.z_star,
+            delta: c.delta,
+            twist,
+            branch,
+            detail,
+        }
+    }
+}
+
+/// Label events as in the paper's figures: walls W1, W2, … by increasing φ on
+/// each branch, S for branch points, F for folds, J for jumps, and X, X2, …
+/// for crossings in the order met from the start of the branch.
+pub fn label_events(events: &mut [Event]) {
+    let mut crossings = HashMap::<(usize, u64), usize>::new();
+    for e in events.iter_mut().filter(|e| e.kind == EventKind::Crossing) {
+        let k = crossings.entry((e.branch, e.z_star.to_bits())).or_insert(0);
+        *k += 1;
+        e.label = if *k == 1 { "X".into() } else { format!("X{k}") };
+    }
+    let mut order: Vec<usize> = (0..events.len()).collect();
+    order.sort_by(|&i, &j| {
+        (
+            events[i].branch,
+            events[i].z_star.to_bits(),
+            events[i].phi_over_2pi,
+        )
+            .partial_cmp(&(
+                events[j].branch,
+                events[j].z_star.to_bits(),
+                events[j].phi_over_2pi,
+            ))
+            .unwrap()
+    });
+    let mut counters = HashMap::<(usize, u64, &str), usize>::new();
+    for &i in &order {
+        let Some(prefix) = events[i].kind.label_prefix() else {
+            continue;
+        };
+        if prefix == "X" {
+            continue;
+        }
+        let key = (events[i].branch, events[i].z_star.to_bits(), prefix);
+        let k = counters.entry(key).or_insert(0);
+        *k += 1;
+        events[i].label = if prefix == "W" || prefix == "F" || prefix == "J" || *k > 1 {
+            format!("{prefix}{k}")
+        } else {
+            prefix.to_string()
+        };
+    }
+}
