@@ -26,7 +26,7 @@ fn bench(c: &mut Criterion) {
     let d = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
     let measure = Measure {
         eigenvalues: 1,
-        ..Measure::of(&d)
+        ..d.measure()
     };
     let solved: Vec<_> = SIZES
         .iter()

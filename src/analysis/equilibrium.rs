@@ -10,12 +10,10 @@ use crate::geometry::writhe::writhe_closed;
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::contact_hessian::ContactHessian;
 use crate::model::energy::{RodEnergy, vertex_strains};
-use crate::model::rod::{Clamps, Law, RodModel, RodState};
-use crate::model::shooting::{ShootingSolution, refine_shooting};
-use crate::scene::{InitialShape, Scene};
+use crate::model::rod::{Law, RodState};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -121,18 +119,6 @@ pub struct Measure {
     pub self_distance_gap: f64,
     /// Ray length of the writhe closure.
     pub ray_length: f64,
-}
-
-impl Measure {
-    /// The measurement settings of a scene.
-    pub fn of(scene: &Scene) -> Self {
-        Measure {
-            eigenvalues: scene.stability.eigenvalues as usize,
-            rod_diameter: scene.model.rod_diameter,
-            self_distance_gap: scene.diagnostics.self_distance_gap,
-            ray_length: scene.diagnostics.ray_length,
-        }
-    }
 }
 
 /// Writhe, knot type, walls and distances of a state (see [`Equilibrium`]).

@@ -44,7 +44,7 @@ impl Summary {
         Summary {
             scene: scene.name.clone().unwrap_or_default(),
             model: ModelSummary {
-                kind: scene.model.kind.clone(),
+                kind: scene.model.kind.name().into(),
                 k2: model.k2,
                 k3: model.k3,
                 stretching_stiffness: model.stretching_stiffness,

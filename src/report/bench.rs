@@ -1,7 +1,7 @@
 //! `knotrod bench`: standard workloads timed with their work counts, and the
 //! growth of per-step costs with N (fitted exponents).
 
-use crate::analysis::equilibrium::{Measure, Shape};
+use crate::analysis::equilibrium::Shape;
 use crate::geometry::closure::ray_closure;
 use crate::geometry::distance::min_self_distance;
 use crate::geometry::knot::knot_type;
@@ -215,7 +215,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
                 min_self_distance(&p, &arc, 0.05);
             }),
         );
-        let m = Measure::of(&d);
+        let m = d.measure();
         // per continuation step: writhe and knot type carried from the
         // previous point (the full O(N²) ones run only where strands meet)
         push(

@@ -1,7 +1,15 @@
 //! Scene files (TOML): model, clamps, initial shape, solver settings, outputs.
 //! Every field is checked; errors name the field.
 
+mod map;
+mod validate;
+
+pub use map::{MapSpec, SliceSpec};
+
+use crate::analysis::equilibrium::Measure;
+use crate::model::contact::ContactModel;
 use crate::model::rod::{Clamps, Law, Parameter, RodModel};
+use crate::solve::continuation::ContinuationSettings;
 use crate::solve::outcome::SolverSettings;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -42,7 +50,7 @@ pub struct Scene {
     pub loading: Vec<LoadingSpec>,
     /// Parameter-space map (with `knotrod map`).
     #[serde(default)]
-    pub map: Option<crate::study::map::MapSpec>,
+    pub map: Option<MapSpec>,
     /// Knot diagnostics settings.
     #[serde(default)]
     pub diagnostics: DiagnosticsSpec,
@@ -61,10 +69,9 @@ pub struct Scene {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
-    /// Model kind: "kirchhoff" (default), "unbendable" (Kirchhoff with u2 = 0
-    /// enforced, K2 → ∞) or "strip" (Sadowsky elastic strip, u2 = 0 enforced).
-    #[serde(default = "default_kind")]
-    pub kind: String,
+    /// Model kind: "kirchhoff" (default), "unbendable" or "strip".
+    #[serde(default)]
+    pub kind: ModelKind,
     /// B22/B11.
     #[serde(rename = "K2", default = "default_k")]
     pub k2: f64,
@@ -94,8 +101,28 @@ fn default_strip_regularisation() -> f64 {
 /// (|u1| ~ 5–30), so it only matters at inflections of a twisted strip.
 pub const STRIP_REGULARISATION: f64 = 0.05;
 
-fn default_kind() -> String {
-    "kirchhoff".into()
+/// Kinds of rod model.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelKind {
+    /// The Kirchhoff rod (bending, twisting, stretching).
+    #[default]
+    Kirchhoff,
+    /// Kirchhoff with u2 = 0 enforced (K2 → ∞).
+    Unbendable,
+    /// The Sadowsky elastic strip, u2 = 0 enforced.
+    Strip,
+}
+
+impl ModelKind {
+    /// The name used in scene files and summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Kirchhoff => "kirchhoff",
+            ModelKind::Unbendable => "unbendable",
+            ModelKind::Strip => "strip",
+        }
+    }
 }
 fn default_k() -> f64 {
     3.0
@@ -225,9 +252,9 @@ pub struct ContinuationSpec {
 
 impl ContinuationSpec {
     /// The numerical continuation settings this spec asks for.
-    pub fn settings(&self) -> crate::solve::continuation::ContinuationSettings {
-        let defaults = crate::solve::continuation::ContinuationSettings::default();
-        crate::solve::continuation::ContinuationSettings {
+    pub fn settings(&self) -> ContinuationSettings {
+        let defaults = ContinuationSettings::default();
+        ContinuationSettings {
             step: self.step.unwrap_or(defaults.step),
             max_step: self.max_step.unwrap_or(defaults.max_step),
             max_points: self.max_points.map_or(defaults.max_points, |m| m as usize),
@@ -394,14 +421,14 @@ pub enum SceneError {
     },
 }
 
-fn invalid(field: &'static str, reason: impl Into<String>) -> SceneError {
+pub(crate) fn invalid(field: &'static str, reason: impl Into<String>) -> SceneError {
     SceneError::Invalid {
         field,
         reason: reason.into(),
     }
 }
 
-fn finite(field: &'static str, v: f64) -> Result<f64, SceneError> {
+pub(crate) fn finite(field: &'static str, v: f64) -> Result<f64, SceneError> {
     if v.is_finite() {
         Ok(v)
     } else {
@@ -409,7 +436,7 @@ fn finite(field: &'static str, v: f64) -> Result<f64, SceneError> {
     }
 }
 
-fn positive(field: &'static str, v: f64) -> Result<f64, SceneError> {
+pub(crate) fn positive(field: &'static str, v: f64) -> Result<f64, SceneError> {
     finite(field, v)?;
     if v > 0.0 {
         Ok(v)
@@ -456,243 +483,6 @@ impl Scene {
         Ok(scene)
     }
 
-    /// Check every value's range.
-    pub fn validate(&self) -> Result<(), SceneError> {
-        let m = &self.model;
-        if !["kirchhoff", "unbendable", "strip"].contains(&m.kind.as_str()) {
-            return Err(invalid(
-                "model.kind",
-                format!(
-                    "unknown model `{}` (known: kirchhoff, unbendable, strip)",
-                    m.kind
-                ),
-            ));
-        }
-        positive("model.strip_regularisation", m.strip_regularisation)?;
-        positive("model.K2", m.k2)?;
-        positive("model.K3", m.k3)?;
-        if m.segments < 4 || m.segments > 1_000_000 {
-            return Err(invalid(
-                "model.segments",
-                format!("must be an integer in 4..=1000000, got {}", m.segments),
-            ));
-        }
-        positive("model.rod_diameter", m.rod_diameter)?;
-        if let Some(s) = m.stretching_stiffness {
-            positive("model.stretching_stiffness", s)?;
-        }
-        let c = &self.clamps;
-        finite("clamps.z_star", c.z_star)?;
-        finite("clamps.delta", c.delta)?;
-        finite("clamps.phi_over_2pi", c.phi_over_2pi)?;
-        if c.delta < 0.0 {
-            return Err(invalid(
-                "clamps.delta",
-                format!("must be >= 0, got {}", c.delta),
-            ));
-        }
-        if c.z_star.abs() > 1.0 {
-            return Err(invalid(
-                "clamps.z_star",
-                format!("|z*| must be <= 1 (the rod has length 1), got {}", c.z_star),
-            ));
-        }
-        if (c.z_star * c.z_star + c.delta * c.delta).sqrt() > 1.0 {
-            return Err(invalid(
-                "clamps.delta",
-                "the clamps are farther apart than the rod's length: sqrt(z*² + δ²) > 1",
-            ));
-        }
-        let i = &self.initial;
-        if i.shape == InitialShape::Shooting {
-            let n0 =
-                i.n0.ok_or_else(|| invalid("initial.n0", "required for shape = \"shooting\""))?;
-            let m0 =
-                i.m0.ok_or_else(|| invalid("initial.m0", "required for shape = \"shooting\""))?;
-            for v in n0 {
-                finite("initial.n0", v)?;
-            }
-            for v in m0 {
-                finite("initial.m0", v)?;
-            }
-        }
-        // RK4 steps of a shooting start, or unfolding steps of the double ring
-        let least = if i.shape == InitialShape::DoubleRing {
-            1
-        } else {
-            10
-        };
-        if let Some(s) = i.steps
-            && !(least..=10_000_000).contains(&s)
-        {
-            return Err(invalid(
-                "initial.steps",
-                format!("must be in {least}..=10000000, got {s}"),
-            ));
-        }
-        if i.shape == InitialShape::File && i.file.is_none() {
-            return Err(invalid("initial.file", "required for shape = \"file\""));
-        }
-        let s = &self.solver;
-        positive("solver.gradient_tol", s.gradient_tol)?;
-        positive("solver.max_step", s.max_step)?;
-        if s.max_iterations == 0 {
-            return Err(invalid("solver.max_iterations", "must be >= 1"));
-        }
-        if let Some(c) = &self.continuation {
-            finite("continuation.range", c.range[0])?;
-            finite("continuation.range", c.range[1])?;
-            if c.range[0] >= c.range[1] {
-                return Err(invalid(
-                    "continuation.range",
-                    "must be [lo, hi] with lo < hi",
-                ));
-            }
-            let start = c.parameter.value(&self.clamps());
-            if start < c.range[0] || start > c.range[1] {
-                return Err(invalid(
-                    "continuation.range",
-                    format!("does not contain the start value {start}"),
-                ));
-            }
-            for (field, v) in [
-                ("continuation.step", c.step),
-                ("continuation.max_step", c.max_step),
-            ] {
-                if let Some(v) = v {
-                    positive(field, v)?;
-                }
-            }
-            if let Some(m) = c.max_points
-                && m < 1
-            {
-                return Err(invalid("continuation.max_points", "must be >= 1"));
-            }
-        }
-        if !self.loading.is_empty() && self.continuation.is_some() {
-            return Err(invalid(
-                "loading",
-                "a scene has either [[loading]] or [continuation], not both",
-            ));
-        }
-        for l in &self.loading {
-            if l.steps < 1 || l.steps > 1_000_000 {
-                return Err(invalid(
-                    "loading.steps",
-                    format!("must be in 1..=1000000, got {}", l.steps),
-                ));
-            }
-            for (field, v) in [
-                ("loading.z_star", l.z_star),
-                ("loading.delta", l.delta),
-                ("loading.phi_over_2pi", l.phi_over_2pi),
-            ] {
-                if let Some(v) = v {
-                    finite(field, v)?;
-                }
-            }
-            if l.z_star.is_some_and(|z| z.abs() > 1.0) {
-                return Err(invalid("loading.z_star", "|z*| must be <= 1"));
-            }
-            if l.delta.is_some_and(|d| d < 0.0) {
-                return Err(invalid("loading.delta", "must be >= 0"));
-            }
-        }
-        if let Some(sw) = &self.sweep {
-            if self.continuation.is_none() {
-                return Err(invalid("sweep", "needs a [continuation] to repeat"));
-            }
-            if sw.values.is_empty() {
-                return Err(invalid("sweep.values", "must not be empty"));
-            }
-            for v in &sw.values {
-                finite("sweep.values", *v)?;
-            }
-            if Some(sw.parameter) == self.continuation.as_ref().map(|c| c.parameter) {
-                return Err(invalid(
-                    "sweep.parameter",
-                    "must differ from continuation.parameter",
-                ));
-            }
-        }
-        if let Some(m) = &self.map {
-            if self.continuation.is_none() {
-                return Err(invalid("map", "needs a [continuation] giving the branches"));
-            }
-            finite("map.range", m.range[0])?;
-            finite("map.range", m.range[1])?;
-            if m.lines == 0 || m.lines > 100_000 {
-                return Err(invalid("map.lines", "must be in 1..=100000"));
-            }
-            if m.grid_columns < 2 {
-                return Err(invalid("map.grid_columns", "must be >= 2"));
-            }
-            positive("map.trace_step", m.trace_step)?;
-            for v in m.trace_from.iter().flatten() {
-                finite("map.trace_from", *v)?;
-            }
-            if let Some(sl) = &m.slices {
-                if sl.values.is_empty() || sl.values.iter().any(|v| !v.is_finite()) {
-                    return Err(invalid("map.slices.values", "must be finite and non-empty"));
-                }
-                if sl.values.windows(2).any(|w| w[1] <= w[0]) {
-                    return Err(invalid("map.slices.values", "must be increasing"));
-                }
-                if sl.parameter == m.parameter
-                    || Some(sl.parameter) == self.continuation.as_ref().map(|c| c.parameter)
-                {
-                    return Err(invalid(
-                        "map.slices.parameter",
-                        "must differ from map.parameter and continuation.parameter",
-                    ));
-                }
-                if let Some(p) = &sl.start_phi_over_2pi
-                    && p.len() != sl.values.len()
-                {
-                    return Err(invalid(
-                        "map.slices.start_phi_over_2pi",
-                        "needs one value per slice",
-                    ));
-                }
-                for v in sl.trace_from.iter().flatten().flatten() {
-                    finite("map.slices.trace_from", *v)?;
-                }
-                if let Some(p) = &sl.trace_from
-                    && p.len() != sl.values.len()
-                {
-                    return Err(invalid(
-                        "map.slices.trace_from",
-                        "needs one point per slice",
-                    ));
-                }
-            }
-        }
-        if let Some(c) = &self.contact {
-            positive("contact.margin", c.margin)?;
-            for o in &c.obstacles {
-                for v in o {
-                    finite("contact.obstacles", *v)?;
-                }
-            }
-        }
-        let d = &self.diagnostics;
-        positive("diagnostics.self_distance_gap", d.self_distance_gap)?;
-        if d.self_distance_gap >= 0.5 {
-            return Err(invalid(
-                "diagnostics.self_distance_gap",
-                "must be < 0.5 (half the rod)",
-            ));
-        }
-        positive("diagnostics.ray_length", d.ray_length)?;
-        if self.stability.eigenvalues < 0 || self.stability.eigenvalues > 100 {
-            return Err(invalid(
-                "stability.eigenvalues",
-                format!("must be in 0..=100, got {}", self.stability.eigenvalues),
-            ));
-        }
-        Ok(())
-    }
-
     /// The rod model (with N replaced if `segments` is given).
     pub fn rod_model(&self, segments: Option<usize>) -> RodModel {
         let m = &self.model;
@@ -703,38 +493,46 @@ impl Scene {
             stretching_stiffness: m
                 .stretching_stiffness
                 .unwrap_or_else(|| RodModel::circular_stretching_stiffness(m.rod_diameter)),
-            law: match m.kind.as_str() {
-                "unbendable" => Law::Unbendable,
-                "strip" => Law::Strip {
+            law: match m.kind {
+                ModelKind::Kirchhoff => Law::Kirchhoff,
+                ModelKind::Unbendable => Law::Unbendable,
+                ModelKind::Strip => Law::Strip {
                     regularisation: m.strip_regularisation,
                 },
-                _ => Law::Kirchhoff,
             },
         }
     }
 
     /// The contact model, if the scene has a `[contact]` section.
-    pub fn contact_model(&self) -> Option<crate::model::contact::ContactModel> {
-        self.contact
-            .as_ref()
-            .map(|c| crate::model::contact::ContactModel {
-                diameter: self.model.rod_diameter,
-                rays: c.rays,
-                self_contact: c.self_contact,
-                gap: self.diagnostics.self_distance_gap,
-                obstacles: c
-                    .obstacles
-                    .iter()
-                    .map(|o| {
-                        [
-                            nalgebra::Vector3::new(o[0], o[1], o[2]),
-                            nalgebra::Vector3::new(o[3], o[4], o[5]),
-                        ]
-                    })
-                    .collect(),
-                margin: c.margin,
-                ray_length: 10.0,
-            })
+    pub fn contact_model(&self) -> Option<ContactModel> {
+        self.contact.as_ref().map(|c| ContactModel {
+            diameter: self.model.rod_diameter,
+            rays: c.rays,
+            self_contact: c.self_contact,
+            gap: self.diagnostics.self_distance_gap,
+            obstacles: c
+                .obstacles
+                .iter()
+                .map(|o| {
+                    [
+                        nalgebra::Vector3::new(o[0], o[1], o[2]),
+                        nalgebra::Vector3::new(o[3], o[4], o[5]),
+                    ]
+                })
+                .collect(),
+            margin: c.margin,
+            ray_length: 10.0,
+        })
+    }
+
+    /// The measurement settings of its equilibria.
+    pub fn measure(&self) -> Measure {
+        Measure {
+            eigenvalues: self.stability.eigenvalues as usize,
+            rod_diameter: self.model.rod_diameter,
+            self_distance_gap: self.diagnostics.self_distance_gap,
+            ray_length: self.diagnostics.ray_length,
+        }
     }
 
     /// The clamps.

@@ -10,7 +10,6 @@ use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point,
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
 use anyhow::{Context, Result};
-use serde::{Deserialize, Serialize};
 
 /// Test functions watched along a branch.
 #[derive(Clone, Debug)]

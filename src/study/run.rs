@@ -1,7 +1,7 @@
 //! Running a scene: one equilibrium, or branches of equilibria (continuation,
 //! optionally swept over a second parameter).
 
-use crate::analysis::equilibrium::{Measure, analyse};
+use crate::analysis::equilibrium::analyse;
 use crate::analysis::event::{Event, label_events};
 use crate::model::rod::{Parameter, RodState};
 use crate::scene::{Direction, Scene};
@@ -86,7 +86,7 @@ pub fn run_scene(
     observer: &mut Observer<'_>,
 ) -> Result<Vec<Event>> {
     let (mut newton, mut state, report) = starting_equilibrium(scene, segments)?;
-    let measure = Measure::of(scene);
+    let measure = scene.measure();
     if !scene.loading.is_empty() {
         let mut events = run_loading(
             &mut newton,

@@ -2,7 +2,7 @@
 //! double ring, trefoil, or a restart state) relaxed by the minimiser.
 
 use crate::analysis::class::is_trefoil;
-use crate::analysis::equilibrium::{Equilibrium, Measure, Shape, analyse};
+use crate::analysis::equilibrium::{Equilibrium, Shape, analyse};
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
@@ -77,7 +77,7 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
                 state.reference_twist[n] = rt + 2.0 * std::f64::consts::PI * turns;
             };
             set(&mut state, 0.0);
-            let shape = Shape::of(&state, &Measure::of(scene));
+            let shape = Shape::of(&state, &scene.measure());
             if !is_trefoil(shape.knot.determinant) {
                 bail!(
                     "initial.shape = \"trefoil\": at z* = {}, δ = {} the guide curve's ray \
@@ -183,5 +183,5 @@ pub fn starting_equilibrium(
 /// Solve a scene's single equilibrium at N segments (the scene's own N if None).
 pub fn solve_scene(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
     let (mut newton, state, report) = starting_equilibrium(scene, segments)?;
-    analyse(&mut newton, &state, &report, &Measure::of(scene))
+    analyse(&mut newton, &state, &report, &scene.measure())
 }

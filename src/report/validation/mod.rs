@@ -535,7 +535,7 @@ fn island_table_of(scenes: &Path, name: &str, paper: &[&str]) -> Result<String> 
 /// thin sliver of another class.
 fn refined_ends(
     scene: &Scene,
-    spec: &crate::study::map::MapSpec,
+    spec: &crate::scene::MapSpec,
     map: &crate::study::map::Map,
     t: &crate::study::boundary::Traced,
 ) -> Result<String> {

@@ -27,8 +27,9 @@ mod walk;
 pub use condition::{Condition, Other, Strands};
 
 use crate::model::rod::Parameter;
+use crate::scene::MapSpec;
 use crate::scene::Scene;
-use crate::study::map::{Line, MapSpec};
+use crate::study::map::Line;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -8,9 +8,9 @@ use crate::analysis::class::is_trefoil;
 use crate::analysis::equilibrium::Measure;
 use crate::geometry::closure::closure_knot;
 use crate::model::rod::{Clamps, Parameter, RodState};
+use crate::scene::MapSpec;
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
-use crate::study::map::MapSpec;
 use crate::study::start::starting_equilibrium;
 use anyhow::{Context, Result, bail};
 
@@ -363,7 +363,7 @@ pub fn trace_island(
     let base = state.clamps;
     let mut walk = Walk {
         tracer: &mut tracer,
-        measure: Measure::of(scene),
+        measure: scene.measure(),
         base,
         swept: spec.parameter,
         bounds: [spec.range, cont.range],

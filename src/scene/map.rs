@@ -1,0 +1,93 @@
+//! `[map]` and `[map.slices]`: the parameter-space map of a scene.
+
+use crate::model::rod::Parameter;
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+
+/// The map settings of a scene: `[map]`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapSpec {
+    /// The swept parameter (default z_star).
+    #[serde(default = "default_sweep")]
+    pub parameter: Parameter,
+    /// Its values, evenly spaced from range[0] to range[1].
+    pub range: [f64; 2],
+    /// Number of lines.
+    pub lines: usize,
+    /// Columns of the classified grid.
+    #[serde(default = "default_columns")]
+    pub grid_columns: usize,
+    /// A known good knot (parameter, φ/2π) the boundary walk starts from,
+    /// reached from the scene's start in a straight line (default: the start).
+    #[serde(default)]
+    pub trace_from: Option<[f64; 2]>,
+    /// Largest step of the boundary walk in the (parameter, φ/2π) plane.
+    #[serde(default = "default_trace_step")]
+    pub trace_step: f64,
+    /// A 3D map: one such map per value of a third parameter.
+    #[serde(default)]
+    pub slices: Option<SliceSpec>,
+}
+
+/// `[map.slices]`: the slices of a 3D map (e.g. δ for Figure 9).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SliceSpec {
+    /// The slicing parameter (default delta).
+    #[serde(default = "default_slicing")]
+    pub parameter: Parameter,
+    /// Its values, increasing.
+    pub values: Vec<f64>,
+    /// φ/2π of each slice's starting equilibrium (default: the scene's).
+    #[serde(default)]
+    pub start_phi_over_2pi: Option<Vec<f64>>,
+    /// Each slice's good knot to start the boundary walk from (`map.trace_from`).
+    #[serde(default)]
+    pub trace_from: Option<Vec<[f64; 2]>>,
+}
+
+fn default_slicing() -> Parameter {
+    Parameter::Delta
+}
+
+impl SliceSpec {
+    /// The scene of slice k: its parameter set, its start φ.
+    pub fn scene(&self, scene: &Scene, k: usize) -> Scene {
+        let mut s = scene.clone();
+        let c = self.parameter.with(&scene.clamps(), self.values[k]);
+        s.clamps.z_star = c.z_star;
+        s.clamps.delta = c.delta;
+        s.clamps.phi_over_2pi = c.phi_over_2pi();
+        if let Some(p) = &self.start_phi_over_2pi {
+            s.clamps.phi_over_2pi = p[k];
+        }
+        if let Some(m) = s.map.as_mut() {
+            m.slices = None;
+            if let Some(t) = &self.trace_from {
+                m.trace_from = Some(t[k]);
+            }
+        }
+        s
+    }
+}
+
+fn default_sweep() -> Parameter {
+    Parameter::ZStar
+}
+fn default_trace_step() -> f64 {
+    0.005
+}
+fn default_columns() -> usize {
+    101
+}
+
+impl MapSpec {
+    /// Value of line k.
+    pub fn value(&self, k: usize) -> f64 {
+        if self.lines == 1 {
+            return self.range[0];
+        }
+        self.range[0] + (self.range[1] - self.range[0]) * k as f64 / (self.lines - 1) as f64
+    }
+}

@@ -1,0 +1,300 @@
+//! Scene validation: every value's range checked, the error naming the field.
+
+use crate::scene::InitialShape;
+use crate::scene::{Scene, SceneError, finite, invalid, positive};
+
+impl Scene {
+    /// Check every value's range (sections in the order of the file).
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.check_model()?;
+        self.check_clamps()?;
+        self.check_initial()?;
+        self.check_solver()?;
+        self.check_continuation()?;
+        self.check_loading()?;
+        self.check_sweep()?;
+        self.check_map()?;
+        self.check_contact()?;
+        self.check_diagnostics()?;
+        self.check_stability()?;
+        Ok(())
+    }
+
+    /// `[model]`: a known kind, positive stiffnesses, N in range.
+    fn check_model(&self) -> Result<(), SceneError> {
+        let m = &self.model;
+        positive("model.strip_regularisation", m.strip_regularisation)?;
+        positive("model.K2", m.k2)?;
+        positive("model.K3", m.k3)?;
+        if m.segments < 4 || m.segments > 1_000_000 {
+            return Err(invalid(
+                "model.segments",
+                format!("must be an integer in 4..=1000000, got {}", m.segments),
+            ));
+        }
+        positive("model.rod_diameter", m.rod_diameter)?;
+        if let Some(s) = m.stretching_stiffness {
+            positive("model.stretching_stiffness", s)?;
+        }
+        Ok(())
+    }
+
+    /// `[clamps]`: finite, δ ≥ 0, the clamps no farther apart than the rod is long.
+    fn check_clamps(&self) -> Result<(), SceneError> {
+        let c = &self.clamps;
+        finite("clamps.z_star", c.z_star)?;
+        finite("clamps.delta", c.delta)?;
+        finite("clamps.phi_over_2pi", c.phi_over_2pi)?;
+        if c.delta < 0.0 {
+            return Err(invalid(
+                "clamps.delta",
+                format!("must be >= 0, got {}", c.delta),
+            ));
+        }
+        if c.z_star.abs() > 1.0 {
+            return Err(invalid(
+                "clamps.z_star",
+                format!("|z*| must be <= 1 (the rod has length 1), got {}", c.z_star),
+            ));
+        }
+        if (c.z_star * c.z_star + c.delta * c.delta).sqrt() > 1.0 {
+            return Err(invalid(
+                "clamps.delta",
+                "the clamps are farther apart than the rod's length: sqrt(z*² + δ²) > 1",
+            ));
+        }
+        Ok(())
+    }
+
+    /// `[initial]`: the data each shape needs.
+    fn check_initial(&self) -> Result<(), SceneError> {
+        let i = &self.initial;
+        if i.shape == InitialShape::Shooting {
+            let n0 =
+                i.n0.ok_or_else(|| invalid("initial.n0", "required for shape = \"shooting\""))?;
+            let m0 =
+                i.m0.ok_or_else(|| invalid("initial.m0", "required for shape = \"shooting\""))?;
+            for v in n0 {
+                finite("initial.n0", v)?;
+            }
+            for v in m0 {
+                finite("initial.m0", v)?;
+            }
+        }
+        // RK4 steps of a shooting start, or unfolding steps of the double ring
+        let least = if i.shape == InitialShape::DoubleRing {
+            1
+        } else {
+            10
+        };
+        if let Some(s) = i.steps
+            && !(least..=10_000_000).contains(&s)
+        {
+            return Err(invalid(
+                "initial.steps",
+                format!("must be in {least}..=10000000, got {s}"),
+            ));
+        }
+        if i.shape == InitialShape::File && i.file.is_none() {
+            return Err(invalid("initial.file", "required for shape = \"file\""));
+        }
+        Ok(())
+    }
+
+    /// `[solver]`: positive tolerances and a budget.
+    fn check_solver(&self) -> Result<(), SceneError> {
+        let s = &self.solver;
+        positive("solver.gradient_tol", s.gradient_tol)?;
+        positive("solver.max_step", s.max_step)?;
+        if s.max_iterations == 0 {
+            return Err(invalid("solver.max_iterations", "must be >= 1"));
+        }
+        Ok(())
+    }
+
+    /// `[continuation]`: a range holding the start, positive steps.
+    fn check_continuation(&self) -> Result<(), SceneError> {
+        if let Some(c) = &self.continuation {
+            finite("continuation.range", c.range[0])?;
+            finite("continuation.range", c.range[1])?;
+            if c.range[0] >= c.range[1] {
+                return Err(invalid(
+                    "continuation.range",
+                    "must be [lo, hi] with lo < hi",
+                ));
+            }
+            let start = c.parameter.value(&self.clamps());
+            if start < c.range[0] || start > c.range[1] {
+                return Err(invalid(
+                    "continuation.range",
+                    format!("does not contain the start value {start}"),
+                ));
+            }
+            for (field, v) in [
+                ("continuation.step", c.step),
+                ("continuation.max_step", c.max_step),
+            ] {
+                if let Some(v) = v {
+                    positive(field, v)?;
+                }
+            }
+            if let Some(m) = c.max_points
+                && m < 1
+            {
+                return Err(invalid("continuation.max_points", "must be >= 1"));
+            }
+        }
+        Ok(())
+    }
+
+    /// `[[loading]]`: alone (no continuation), finite targets, step counts in range.
+    fn check_loading(&self) -> Result<(), SceneError> {
+        if !self.loading.is_empty() && self.continuation.is_some() {
+            return Err(invalid(
+                "loading",
+                "a scene has either [[loading]] or [continuation], not both",
+            ));
+        }
+        for l in &self.loading {
+            if l.steps < 1 || l.steps > 1_000_000 {
+                return Err(invalid(
+                    "loading.steps",
+                    format!("must be in 1..=1000000, got {}", l.steps),
+                ));
+            }
+            for (field, v) in [
+                ("loading.z_star", l.z_star),
+                ("loading.delta", l.delta),
+                ("loading.phi_over_2pi", l.phi_over_2pi),
+            ] {
+                if let Some(v) = v {
+                    finite(field, v)?;
+                }
+            }
+            if l.z_star.is_some_and(|z| z.abs() > 1.0) {
+                return Err(invalid("loading.z_star", "|z*| must be <= 1"));
+            }
+            if l.delta.is_some_and(|d| d < 0.0) {
+                return Err(invalid("loading.delta", "must be >= 0"));
+            }
+        }
+        Ok(())
+    }
+
+    /// `[sweep]`: a continuation to repeat, finite values, another parameter.
+    fn check_sweep(&self) -> Result<(), SceneError> {
+        if let Some(sw) = &self.sweep {
+            if self.continuation.is_none() {
+                return Err(invalid("sweep", "needs a [continuation] to repeat"));
+            }
+            if sw.values.is_empty() {
+                return Err(invalid("sweep.values", "must not be empty"));
+            }
+            for v in &sw.values {
+                finite("sweep.values", *v)?;
+            }
+            if Some(sw.parameter) == self.continuation.as_ref().map(|c| c.parameter) {
+                return Err(invalid(
+                    "sweep.parameter",
+                    "must differ from continuation.parameter",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// `[map]` and `[map.slices]`.
+    fn check_map(&self) -> Result<(), SceneError> {
+        if let Some(m) = &self.map {
+            if self.continuation.is_none() {
+                return Err(invalid("map", "needs a [continuation] giving the branches"));
+            }
+            finite("map.range", m.range[0])?;
+            finite("map.range", m.range[1])?;
+            if m.lines == 0 || m.lines > 100_000 {
+                return Err(invalid("map.lines", "must be in 1..=100000"));
+            }
+            if m.grid_columns < 2 {
+                return Err(invalid("map.grid_columns", "must be >= 2"));
+            }
+            positive("map.trace_step", m.trace_step)?;
+            for v in m.trace_from.iter().flatten() {
+                finite("map.trace_from", *v)?;
+            }
+            if let Some(sl) = &m.slices {
+                if sl.values.is_empty() || sl.values.iter().any(|v| !v.is_finite()) {
+                    return Err(invalid("map.slices.values", "must be finite and non-empty"));
+                }
+                if sl.values.windows(2).any(|w| w[1] <= w[0]) {
+                    return Err(invalid("map.slices.values", "must be increasing"));
+                }
+                if sl.parameter == m.parameter
+                    || Some(sl.parameter) == self.continuation.as_ref().map(|c| c.parameter)
+                {
+                    return Err(invalid(
+                        "map.slices.parameter",
+                        "must differ from map.parameter and continuation.parameter",
+                    ));
+                }
+                if let Some(p) = &sl.start_phi_over_2pi
+                    && p.len() != sl.values.len()
+                {
+                    return Err(invalid(
+                        "map.slices.start_phi_over_2pi",
+                        "needs one value per slice",
+                    ));
+                }
+                for v in sl.trace_from.iter().flatten().flatten() {
+                    finite("map.slices.trace_from", *v)?;
+                }
+                if let Some(p) = &sl.trace_from
+                    && p.len() != sl.values.len()
+                {
+                    return Err(invalid(
+                        "map.slices.trace_from",
+                        "needs one point per slice",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `[contact]`: a positive margin, finite obstacles.
+    fn check_contact(&self) -> Result<(), SceneError> {
+        if let Some(c) = &self.contact {
+            positive("contact.margin", c.margin)?;
+            for o in &c.obstacles {
+                for v in o {
+                    finite("contact.obstacles", *v)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `[diagnostics]`: a gap below half the rod, a positive ray length.
+    fn check_diagnostics(&self) -> Result<(), SceneError> {
+        let d = &self.diagnostics;
+        positive("diagnostics.self_distance_gap", d.self_distance_gap)?;
+        if d.self_distance_gap >= 0.5 {
+            return Err(invalid(
+                "diagnostics.self_distance_gap",
+                "must be < 0.5 (half the rod)",
+            ));
+        }
+        positive("diagnostics.ray_length", d.ray_length)?;
+        Ok(())
+    }
+
+    /// `[stability]`: a sensible eigenvalue count.
+    fn check_stability(&self) -> Result<(), SceneError> {
+        if self.stability.eigenvalues < 0 || self.stability.eigenvalues > 100 {
+            return Err(invalid(
+                "stability.eigenvalues",
+                format!("must be in 0..=100, got {}", self.stability.eigenvalues),
+            ));
+        }
+        Ok(())
+    }
+}
