@@ -7,13 +7,13 @@ use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
 use crate::geometry::knot::KnotType;
 use crate::geometry::walls::wall_clearance;
 use crate::geometry::writhe::writhe_closed;
+use crate::linalg::eigen::StabilityError;
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::contact_hessian::ContactHessian;
 use crate::model::energy::{RodEnergy, vertex_strains};
 use crate::model::rod::{Law, RodState};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
-use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -106,6 +106,17 @@ pub struct Equilibrium {
     pub leg: usize,
     /// The full discrete state (restart with `[initial] shape = "file"`).
     pub state: RodState,
+}
+
+/// Measuring an equilibrium failed: its stability analysis (the step named).
+#[derive(Debug, thiserror::Error)]
+#[error("{step}")]
+pub struct AnalysisError {
+    /// Which analysis.
+    pub step: &'static str,
+    /// Why.
+    #[source]
+    pub source: StabilityError,
 }
 
 /// Settings of the measurements of an equilibrium.
@@ -258,7 +269,7 @@ pub fn analyse(
     state: &RodState,
     report: &SolveReport,
     measure: &Measure,
-) -> Result<Equilibrium> {
+) -> Result<Equilibrium, AnalysisError> {
     analyse_from(newton, state, report, measure, None, None)
 }
 
@@ -273,7 +284,7 @@ pub fn analyse_from(
     measure: &Measure,
     previous: Option<&Equilibrium>,
     hessian: Option<&[f64]>,
-) -> Result<Equilibrium> {
+) -> Result<Equilibrium, AnalysisError> {
     let k = measure.eigenvalues;
     let energy: &RodEnergy = &newton.energy;
     let values = match hessian {
@@ -292,12 +303,18 @@ pub fn analyse_from(
         None => (&energy.pattern, &values, &mut newton.ldlt),
     };
     let plain =
-        lowest_eigenvalues(pattern, values, None, k, ldlt).context("stability of the Hessian")?;
+        lowest_eigenvalues(pattern, values, None, k, ldlt).map_err(|source| AnalysisError {
+            step: "stability of the Hessian",
+            source,
+        })?;
     // with no eigenvalues asked the inertia is all, and the pencil adds nothing
     let pencil_values = if k > 0 {
         let mass = energy.lumped_mass();
         lowest_eigenvalues(pattern, values, Some(&mass), k, ldlt)
-            .context("stability with the lumped mass")?
+            .map_err(|source| AnalysisError {
+                step: "stability with the lumped mass",
+                source,
+            })?
             .values
     } else {
         Vec::new()

@@ -8,6 +8,7 @@ use crate::io::plot::{PlotPoint, bifurcation_diagram};
 use crate::io::summary::{Summary, print_equilibrium, print_events};
 use crate::report::validation;
 use crate::scene::Scene;
+use crate::study::error::StudyError;
 use crate::study::run::run_scene;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
@@ -219,7 +220,7 @@ pub fn main_with(cli: Cli) -> Result<()> {
             segments,
         } => map_command(&scene, json, shard.as_deref(), segments),
         Command::Merge { parts, json } => {
-            let map = crate::study::map::merge(&parts)?;
+            let map = crate::io::map_files::merge(&parts)?;
             write_map(&map, &json)
         }
         Command::Bench { scenes, json } => {
@@ -300,7 +301,7 @@ fn run(
     );
     let mut equilibria = Vec::new();
     let result = {
-        let mut observer = |eq: crate::analysis::equilibrium::Equilibrium| -> Result<()> {
+        let mut record = |eq: crate::analysis::equilibrium::Equilibrium| -> Result<()> {
             if let Some((w, _)) = stream.as_mut() {
                 serde_json::to_writer(&mut *w, &eq)?;
                 w.write_all(b"\n")?;
@@ -325,6 +326,7 @@ fn run(
             }
             Ok(())
         };
+        let mut observer = |eq| record(eq).map_err(|e| StudyError::Observer(e.into()));
         run_scene(&scene, segments, &mut observer)
     };
     progress.finish_and_clear();
@@ -383,7 +385,7 @@ fn run(
         writeln!(out, "summary written to {}", path.display())?;
     }
     match failed {
-        Some(e) => Err(e),
+        Some(e) => Err(e.into()),
         None => Ok(()),
     }
 }
@@ -597,7 +599,7 @@ fn map_command(
     let name = scene.name.clone().unwrap_or_else(|| "map".into());
     let json = json.unwrap_or_else(|| PathBuf::from("recordings").join(format!("{name}.map.json")));
     let shard = match shard {
-        Some(s) => Some(crate::study::map::parse_shard(s)?),
+        Some(s) => Some(parse_shard(s)?),
         None => None,
     };
     let Some(slices) = spec.slices.clone() else {
@@ -684,7 +686,7 @@ fn map_plane(
         _ => {
             let spinner = indicatif::ProgressBar::new_spinner();
             let t =
-                crate::study::boundary::trace_cached(scene, &spec, segments, &cache, &|k, on| {
+                crate::io::map_files::trace_cached(scene, &spec, segments, &cache, &|k, on| {
                     spinner.set_message(format!("tracing the boundary: point {k}, on {on}"));
                     spinner.tick();
                 })?;
@@ -697,7 +699,8 @@ fn map_plane(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} lines, ETA {eta} — {msg}")
             .unwrap(),
     );
-    let lines = crate::study::map::compute_lines(scene, &spec, &indices, segments, &cache, &|l| {
+    let store = crate::io::map_files::LineFolder::create(&cache)?;
+    let lines = crate::study::map::compute_lines(scene, &spec, &indices, segments, &store, &|l| {
         progress.inc(1);
         progress.set_message(format!(
             "{} = {:.4}: {} good intervals",
@@ -709,7 +712,7 @@ fn map_plane(
     progress.finish_and_clear();
     match shard {
         Some(sh) => {
-            let part = crate::study::map::Partial {
+            let part = crate::io::map_files::Partial {
                 scene: name.to_string(),
                 spec,
                 phi_range: cont.range,
@@ -734,4 +737,14 @@ fn map_plane(
             Ok(Some(map))
         }
     }
+}
+
+/// Parse "i/n".
+fn parse_shard(s: &str) -> Result<(usize, usize)> {
+    let (i, n) = s.split_once('/').context("--shard takes i/n")?;
+    let (i, n): (usize, usize) = (i.trim().parse()?, n.trim().parse()?);
+    if n == 0 || i >= n {
+        anyhow::bail!("--shard {s}: need 0 <= i < n");
+    }
+    Ok((i, n))
 }

@@ -2,6 +2,8 @@
 //! Foxglove geometry), JSON summaries and map files, plots, exports.
 
 pub mod export;
+pub mod map_files;
 pub mod plot;
 pub mod recording;
+pub mod scene_file;
 pub mod summary;

@@ -99,7 +99,9 @@ pub fn run(scenes: &Path) -> Result<Report> {
     let fig7 = Scene::load(&scenes.join("fig7_island_kirchhoff.toml"))?;
     let mut workloads = Vec::new();
     workloads.push(timed("appendix_d_from_shooting", 200, || {
-        crate::study::start::solve_scene(&d, Some(200)).map(|_| ())
+        crate::study::start::solve_scene(&d, Some(200))
+            .map(|_| ())
+            .map_err(Into::into)
     })?);
     let mut main_branch = fig3.clone();
     if let Some(c) = main_branch.continuation.as_mut() {
@@ -111,10 +113,14 @@ pub fn run(scenes: &Path) -> Result<Report> {
     let mut inertia_only = main_branch.clone();
     inertia_only.stability.eigenvalues = 0;
     workloads.push(timed("figure_3_branch", 200, || {
-        crate::study::run::run_scene(&inertia_only, Some(200), &mut |_| Ok(())).map(|_| ())
+        crate::study::run::run_scene(&inertia_only, Some(200), &mut |_| Ok(()))
+            .map(|_| ())
+            .map_err(Into::into)
     })?);
     workloads.push(timed("figure_3_branch_with_eigenvalues", 200, || {
-        crate::study::run::run_scene(&main_branch, Some(200), &mut |_| Ok(())).map(|_| ())
+        crate::study::run::run_scene(&main_branch, Some(200), &mut |_| Ok(()))
+            .map(|_| ())
+            .map_err(Into::into)
     })?);
     let mut island = fig7.clone();
     if let Some(m) = island.map.as_mut() {
@@ -126,7 +132,14 @@ pub fn run(scenes: &Path) -> Result<Report> {
         let cache = std::env::temp_dir().join(format!("knotrod-bench-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&cache);
         let idx: Vec<usize> = (0..spec.lines).collect();
-        crate::study::map::compute_lines(&island, &spec, &idx, Some(60), &cache, &|_| {})?;
+        crate::study::map::compute_lines(
+            &island,
+            &spec,
+            &idx,
+            Some(60),
+            &crate::io::map_files::LineFolder::create(&cache)?,
+            &|_| {},
+        )?;
         let _ = std::fs::remove_dir_all(&cache);
         Ok(())
     })?);
@@ -136,9 +149,16 @@ pub fn run(scenes: &Path) -> Result<Report> {
         let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
         let cache = std::env::temp_dir().join(format!("knotrod-bench-map-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&cache);
-        let t = crate::study::boundary::trace_cached(&fig7, &spec, None, &cache, &|_, _| {})?;
+        let t = crate::io::map_files::trace_cached(&fig7, &spec, None, &cache, &|_, _| {})?;
         let idx: Vec<usize> = (0..spec.lines).collect();
-        crate::study::map::compute_lines(&fig7, &spec, &idx, None, &cache, &|_| {})?;
+        crate::study::map::compute_lines(
+            &fig7,
+            &spec,
+            &idx,
+            None,
+            &crate::io::map_files::LineFolder::create(&cache)?,
+            &|_| {},
+        )?;
         let _ = std::fs::remove_dir_all(&cache);
         if !t.closed {
             anyhow::bail!("boundary walk did not close: {:?}", t.stopped);

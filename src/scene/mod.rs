@@ -8,11 +8,11 @@ pub use map::{MapSpec, SliceSpec};
 
 use crate::analysis::equilibrium::Measure;
 use crate::model::contact::ContactModel;
-use crate::model::rod::{Clamps, Law, Parameter, RodModel};
+use crate::model::rod::{Clamps, Law, Parameter, RodModel, RodState};
 use crate::solve::continuation::ContinuationSettings;
 use crate::solve::outcome::SolverSettings;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A scene as written in TOML.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -186,6 +186,10 @@ pub struct InitialSpec {
     /// less φ/2π) to give it; default 3, the paper's configuration A.
     #[serde(default)]
     pub link: Option<i64>,
+    /// The restart state of `file` or `from_recording`, read with the scene
+    /// (`Scene::load`); not part of the scene's text.
+    #[serde(skip)]
+    pub state: Option<RodState>,
 }
 
 /// Kinds of initial shape.
@@ -446,33 +450,6 @@ pub(crate) fn positive(field: &'static str, v: f64) -> Result<f64, SceneError> {
 }
 
 impl Scene {
-    /// Read and validate a scene file.
-    pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-            path: path.into(),
-            source,
-        })?;
-        let mut scene = Scene::parse(&text).map_err(|e| match e {
-            SceneError::Parse { message, .. } => SceneError::Parse {
-                path: path.into(),
-                message,
-            },
-            other => other,
-        })?;
-        if scene.name.is_none() {
-            scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned());
-        }
-        // relative initial files are relative to the scene's folder
-        if let Some(f) = &scene.initial.file
-            && f.is_relative()
-            && !f.exists()
-            && let Some(dir) = path.parent()
-        {
-            scene.initial.file = Some(dir.join(f));
-        }
-        Ok(scene)
-    }
-
     /// Parse and validate scene text.
     pub fn parse(text: &str) -> Result<Scene, SceneError> {
         let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {

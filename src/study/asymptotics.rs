@@ -5,8 +5,8 @@
 
 use crate::analysis::event::{Event, EventKind};
 use crate::scene::Scene;
+use crate::study::error::{Context, Result, fail};
 use crate::study::run::run_scene;
-use anyhow::{Context, Result, bail};
 use std::f64::consts::PI;
 
 /// δ[1]/β of eq. (6.13): (1 − 1/cos(π/√2)) / 2π = 0.4219…
@@ -77,7 +77,7 @@ pub fn one_contact_shifts(segments: usize, z_star: f64, delta_phi: f64) -> Resul
     at.sort_by(f64::total_cmp);
     match at.as_slice() {
         [lo, .., hi] => Ok((*lo, *hi)),
-        _ => bail!("z* = {z_star}, Δφ = {delta_phi}: found crossings at δ = {at:?}, expected two"),
+        _ => fail!("z* = {z_star}, Δφ = {delta_phi}: found crossings at δ = {at:?}, expected two"),
     }
 }
 
@@ -97,7 +97,7 @@ pub fn max_one_contact_z_star(segments: usize, delta: f64, tol: f64) -> Result<f
     if !crosses_one_contact_curve(segments, lo, delta)?
         || crosses_one_contact_curve(segments, hi, delta)?
     {
-        bail!("δ = {delta}: the one-contact curve's maximum is not within z* ∈ [{lo}, {hi}]");
+        fail!("δ = {delta}: the one-contact curve's maximum is not within z* ∈ [{lo}, {hi}]");
     }
     while hi - lo > tol {
         let mid = 0.5 * (lo + hi);

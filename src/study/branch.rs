@@ -9,7 +9,7 @@ use crate::model::rod::{Parameter, RodState};
 use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
-use anyhow::{Context, Result};
+use crate::study::error::{Context, Result, fail};
 
 /// Test functions watched along a branch.
 #[derive(Clone, Debug)]

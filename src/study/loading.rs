@@ -12,7 +12,7 @@ use crate::scene::LoadingSpec;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolverSettings;
 use crate::study::branch::Observer;
-use anyhow::{Context, Result, bail};
+use crate::study::error::{Context, Result, fail};
 
 /// A step is a jump when the minimiser lands farther than this (rod lengths)
 /// from the first-order prediction (and than half the predicted move).
@@ -64,7 +64,7 @@ pub fn settle(
             .map(|d| mode[d].abs())
             .fold(0.0, f64::max);
         if largest == 0.0 {
-            bail!("saddle with no translational unstable mode");
+            fail!("saddle with no translational unstable mode");
         }
         let mut best: Option<(f64, RodState, crate::solve::outcome::SolveReport)> = None;
         for sign in [1.0, -1.0] {
@@ -79,7 +79,7 @@ pub fn settle(
         *state = s;
         report = r;
     }
-    bail!("could not reach a stable equilibrium from a saddle")
+    fail!("could not reach a stable equilibrium from a saddle")
 }
 
 /// Largest node distance between two states.

@@ -10,10 +10,11 @@ use crate::analysis::class::{Class, is_trefoil};
 use crate::analysis::equilibrium::{Equilibrium, Measure};
 use crate::analysis::event::{Event, EventKind};
 use crate::scene::{MapSpec, Scene, SliceSpec};
+use crate::study::boundary::{GridCheck, Traced};
 use crate::study::branch::{BranchOptions, BranchRun};
+use crate::study::error::{Context, Result, StudyError, describe, fail};
 use crate::study::run::reach;
 use crate::study::start::starting_equilibrium;
-use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -86,7 +87,7 @@ pub struct Map {
     pub grid_boundaries: BTreeMap<String, Vec<[f64; 2]>>,
     /// The boundary traced by two-parameter continuation from the start.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub traced: Option<crate::study::boundary::Traced>,
+    pub traced: Option<Traced>,
     /// Classified grid: rows = lines, columns = `grid_phi`.
     pub grid: Vec<Vec<Class>>,
     /// φ/2π of the grid columns.
@@ -292,7 +293,7 @@ pub fn line(scene: &Scene, spec: &MapSpec, index: usize, segments: Option<usize>
             out.intervals = intervals_of(&out.points, &events);
             out.events = events;
         }
-        Err(e) => out.error = Some(format!("{e:#}")),
+        Err(e) => out.error = Some(describe(&e)),
     }
     out
 }
@@ -338,35 +339,36 @@ pub fn shard_lines(spec: &MapSpec, shard: (usize, usize)) -> Vec<usize> {
     (0..spec.lines).filter(|k| k % shard.1 == shard.0).collect()
 }
 
-/// Compute (or load from `cache`) the given lines in parallel, reporting each.
+/// Where a map's computed lines are kept, so that an interrupted map resumes
+/// (io keeps them as files beside the output).
+pub trait LineStore: Sync {
+    /// Line `index` with parameter value `value`, if it was computed already.
+    fn get(&self, index: usize, value: f64) -> Option<Line>;
+    /// Keep a computed line.
+    fn put(&self, line: &Line)
+    -> std::result::Result<(), Box<dyn std::error::Error + Send + Sync>>;
+}
+
+/// Compute (or take from `store`) the given lines in parallel, reporting each.
 pub fn compute_lines(
     scene: &Scene,
     spec: &MapSpec,
     indices: &[usize],
     segments: Option<usize>,
-    cache: &Path,
+    store: &dyn LineStore,
     on_line: &(dyn Fn(&Line) + Sync),
 ) -> Result<Vec<Line>> {
     use rayon::prelude::*;
-    std::fs::create_dir_all(cache).with_context(|| format!("creating {}", cache.display()))?;
     let mut lines: Vec<Line> = indices
         .par_iter()
         .map(|&k| -> Result<Line> {
-            let file = cache.join(format!("line_{k:05}.json"));
-            // resume: a line already written is not computed again
-            if let Some(l) = std::fs::read_to_string(&file)
-                .ok()
-                .and_then(|t| serde_json::from_str::<Line>(&t).ok())
-                && l.index == k
-                && l.value == spec.value(k)
-            {
+            // resume: a line already kept is not computed again
+            if let Some(l) = store.get(k, spec.value(k)) {
                 on_line(&l);
                 return Ok(l);
             }
             let l = line(scene, spec, k, segments);
-            let tmp = file.with_extension("json.tmp");
-            std::fs::write(&tmp, serde_json::to_vec(&l)?)?;
-            std::fs::rename(&tmp, &file)?;
+            store.put(&l).map_err(StudyError::Observer)?;
             on_line(&l);
             Ok(l)
         })
@@ -381,7 +383,7 @@ pub fn assemble(
     spec: &MapSpec,
     phi_range: [f64; 2],
     mut lines: Vec<Line>,
-    traced: Option<crate::study::boundary::Traced>,
+    traced: Option<Traced>,
 ) -> Map {
     lines.sort_by_key(|l| l.index);
     lines.dedup_by_key(|l| l.index);
@@ -422,7 +424,7 @@ pub fn assemble(
     }
     let grid_boundaries = chain_boundaries(&ends);
     let traced = traced.map(|mut t| {
-        t.grid_check = crate::study::boundary::grid_check(&t, &lines);
+        t.grid_check = grid_check(&t, &lines);
         t
     });
     let boundaries = match &traced {
@@ -520,57 +522,35 @@ fn grid_row(l: &Line, phis: &[f64]) -> Vec<Class> {
         .collect()
 }
 
-/// Parse "i/n".
-pub fn parse_shard(s: &str) -> Result<(usize, usize)> {
-    let (i, n) = s.split_once('/').context("--shard takes i/n")?;
-    let (i, n): (usize, usize) = (i.trim().parse()?, n.trim().parse()?);
-    if n == 0 || i >= n {
-        bail!("--shard {s}: need 0 <= i < n");
+/// Compare a closed traced loop with the grid's good intervals: each line's
+/// interval ends against the loop's crossings of that line.
+pub fn grid_check(traced: &Traced, lines: &[Line]) -> Option<GridCheck> {
+    if !traced.closed {
+        return None;
     }
-    Ok((i, n))
-}
-
-/// A partial result of shard i/n.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Partial {
-    /// Scene name.
-    pub scene: String,
-    /// The map settings.
-    pub spec: MapSpec,
-    /// φ range of the lines.
-    pub phi_range: [f64; 2],
-    /// Shard (i, n).
-    pub shard: (usize, usize),
-    /// Its lines.
-    pub lines: Vec<Line>,
-    /// The traced boundary (shard 0 computes it).
-    #[serde(default)]
-    pub traced: Option<crate::study::boundary::Traced>,
-}
-
-/// Merge partial results into a map.
-pub fn merge(parts: &[PathBuf]) -> Result<Map> {
-    let mut all = Vec::new();
-    let mut head: Option<Partial> = None;
-    let mut traced = None;
-    for p in parts {
-        let text =
-            std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))?;
-        let part: Partial = serde_json::from_str(&text)
-            .with_context(|| format!("{} is not a partial map", p.display()))?;
-        all.extend(part.lines.clone());
-        if part.traced.is_some() {
-            traced = part.traced.clone();
+    let (mut ends, mut worst, mut other) = (0, 0.0f64, Vec::new());
+    for l in lines {
+        let v = l.value;
+        let cuts = traced.cuts(v);
+        let grid: Vec<f64> = l.intervals.iter().flat_map(|i| [i.lo, i.hi]).collect();
+        if cuts.len() != grid.len() {
+            other.push(v);
         }
-        head.get_or_insert(part);
+        if cuts.is_empty() {
+            continue;
+        }
+        for e in grid {
+            let d = cuts
+                .iter()
+                .map(|c| (c - e).abs())
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(d);
+            ends += 1;
+        }
     }
-    let h = head.context("merge needs at least one partial result")?;
-    let map = assemble(&h.scene, &h.spec, h.phi_range, all, traced);
-    let missing: Vec<usize> = (0..h.spec.lines)
-        .filter(|k| !map.lines.iter().any(|l| l.index == *k))
-        .collect();
-    if !missing.is_empty() {
-        bail!("merge: lines {missing:?} are missing (a shard was not merged)");
-    }
-    Ok(map)
+    Some(GridCheck {
+        ends,
+        max_phi_deviation: worst,
+        lines_with_other_count: other,
+    })
 }

@@ -5,6 +5,7 @@
 pub mod asymptotics;
 pub mod boundary;
 pub mod branch;
+pub mod error;
 pub mod loading;
 pub mod map;
 pub mod run;

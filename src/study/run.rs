@@ -8,9 +8,9 @@ use crate::scene::{Direction, Scene};
 use crate::solve::continuation::{ContinuationSettings, Point, Tracer};
 use crate::solve::minimizer::Minimizer;
 use crate::study::branch::{BranchOptions, BranchRun, Observer};
+use crate::study::error::{Context, Result, fail};
 use crate::study::loading::run_loading;
 use crate::study::start::starting_equilibrium;
-use anyhow::{Context, Result, bail};
 
 /// Move an equilibrium to `parameter = target` by continuation in that
 /// parameter (through folds if need be), ending with a Newton solve at exactly
@@ -37,7 +37,7 @@ pub fn reach(
             _ => {
                 ds *= 0.5;
                 if ds < settings.min_step {
-                    bail!(
+                    fail!(
                         "could not reach {} = {target}: branch lost at {pa}",
                         parameter.name()
                     );
@@ -71,7 +71,7 @@ pub fn reach(
         }
         a = b;
     }
-    bail!(
+    fail!(
         "could not reach {} = {target} within {} steps",
         parameter.name(),
         settings.max_points

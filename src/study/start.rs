@@ -6,10 +6,10 @@ use crate::analysis::equilibrium::{Equilibrium, Shape, analyse};
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
-use crate::scene::{InitialShape, Scene};
+use crate::scene::{InitialShape, InitialSpec, Scene};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
-use anyhow::{Context, Result, bail};
+use crate::study::error::{Context, Result, fail};
 use nalgebra::Vector3;
 
 /// The initial state a scene asks for, at N segments.
@@ -17,18 +17,8 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
     let clamps = scene.clamps();
     let n = model.segments;
     let init = &scene.initial;
-    if let Some(path) = &init.from_recording {
-        let msg = crate::io::recording::read_state(path, init.index as u64)
-            .context("initial.from_recording")?;
-        let mut state = msg.state;
-        if state.segments() != n {
-            bail!(
-                "initial.from_recording: state has {} segments, model.segments is {n}",
-                state.segments()
-            );
-        }
-        state.set_clamps(clamps);
-        return Ok(state);
+    if init.from_recording.is_some() {
+        return restart_state(init, "initial.from_recording", n, clamps);
     }
     Ok(match init.shape {
         InitialShape::Straight => match init.bump {
@@ -79,7 +69,7 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
             set(&mut state, 0.0);
             let shape = Shape::of(&state, &scene.measure());
             if !is_trefoil(shape.knot.determinant) {
-                bail!(
+                fail!(
                     "initial.shape = \"trefoil\": at z* = {}, δ = {} the guide curve's ray \
                      closure is not a trefoil (knot determinant {}); start from the \
                      paper's clamps (z* ≈ 0.115, δ ≈ 0.05) and load from there",
@@ -105,39 +95,36 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
             let sol = ShootingSolution::integrate(n0, m0, model.k2, model.k3, steps);
             RodState::from_curve(n, clamps, |s| sol.position(s), |s| sol.d1(s))
         }
-        InitialShape::File => {
-            let path = init.file.as_ref().context("initial.file missing")?;
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("initial.file: cannot read {}", path.display()))?;
-            let summary: serde_json::Value = serde_json::from_str(&text)
-                .with_context(|| format!("initial.file: {} is not JSON", path.display()))?;
-            let entry = summary
-                .get("equilibria")
-                .and_then(|e| e.get(init.index))
-                .and_then(|e| e.get("state"))
-                .with_context(|| {
-                    format!(
-                        "initial.index: {} has no equilibria[{}].state",
-                        path.display(),
-                        init.index
-                    )
-                })?;
-            let mut state: RodState = serde_json::from_value(entry.clone())
-                .with_context(|| format!("initial.file: malformed state in {}", path.display()))?;
-            if state.segments() != n
-                || state.theta.len() != n + 1
-                || state.reference.len() != n + 1
-                || state.reference_twist.len() != n + 1
-            {
-                bail!(
-                    "initial.file: state has {} segments, model.segments is {n}",
-                    state.segments()
-                );
-            }
-            state.set_clamps(clamps);
-            state
-        }
+        InitialShape::File => restart_state(init, "initial.file", n, clamps)?,
     })
+}
+
+/// The restart state of `[initial]` (read from `field`'s file when the scene
+/// was loaded) at the scene's clamps, checked to have N segments.
+fn restart_state(
+    init: &InitialSpec,
+    field: &'static str,
+    n: usize,
+    clamps: Clamps,
+) -> Result<RodState> {
+    let Some(state) = &init.state else {
+        fail!(
+            "{field}: the state was not read (scenes with restart states are read by Scene::load)"
+        );
+    };
+    if state.segments() != n
+        || state.theta.len() != n + 1
+        || state.reference.len() != n + 1
+        || state.reference_twist.len() != n + 1
+    {
+        fail!(
+            "{field}: state has {} segments, model.segments is {n}",
+            state.segments()
+        );
+    }
+    let mut state = state.clone();
+    state.set_clamps(clamps);
+    Ok(state)
 }
 
 /// The scene's starting equilibrium at N segments (the scene's if None): its
@@ -183,5 +170,5 @@ pub fn starting_equilibrium(
 /// Solve a scene's single equilibrium at N segments (the scene's own N if None).
 pub fn solve_scene(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
     let (mut newton, state, report) = starting_equilibrium(scene, segments)?;
-    analyse(&mut newton, &state, &report, &scene.measure())
+    Ok(analyse(&mut newton, &state, &report, &scene.measure())?)
 }

@@ -387,7 +387,9 @@ fn figure_3_events(d: &Scene, n: usize) -> Result<Vec<crate::analysis::event::Ev
         max_step: None,
         max_points: None,
     });
-    crate::study::run::run_scene(&scene, Some(n), &mut |_| Ok(()))
+    Ok(crate::study::run::run_scene(&scene, Some(n), &mut |_| {
+        Ok(())
+    })?)
 }
 
 fn figure_3_table(d: &Scene) -> Result<String> {
@@ -450,8 +452,15 @@ fn island_table_of(scenes: &Path, name: &str, paper: &[&str]) -> Result<String> 
     let cache =
         std::env::temp_dir().join(format!("knotrod-validate-island-{}", std::process::id()));
     let indices: Vec<usize> = (0..spec.lines).collect();
-    let lines = crate::study::map::compute_lines(&scene, &spec, &indices, None, &cache, &|_| {})?;
-    let traced = crate::study::boundary::trace_cached(&scene, &spec, None, &cache, &|_, _| {})?;
+    let lines = crate::study::map::compute_lines(
+        &scene,
+        &spec,
+        &indices,
+        None,
+        &crate::io::map_files::LineFolder::create(&cache)?,
+        &|_| {},
+    )?;
+    let traced = crate::io::map_files::trace_cached(&scene, &spec, None, &cache, &|_, _| {})?;
     let _ = std::fs::remove_dir_all(&cache);
     let map = crate::study::map::assemble(name, &spec, cont.range, lines, Some(traced));
     let mut s = String::new();
@@ -869,9 +878,15 @@ fn map3_table(scenes: &Path) -> Result<String> {
         let cache =
             std::env::temp_dir().join(format!("knotrod-validate-fig9-{}-{k}", std::process::id()));
         let idx: Vec<usize> = (0..sspec.lines).collect();
-        let lines = crate::study::map::compute_lines(&slice, &sspec, &idx, None, &cache, &|_| {})?;
-        let traced =
-            crate::study::boundary::trace_cached(&slice, &sspec, None, &cache, &|_, _| {})?;
+        let lines = crate::study::map::compute_lines(
+            &slice,
+            &sspec,
+            &idx,
+            None,
+            &crate::io::map_files::LineFolder::create(&cache)?,
+            &|_| {},
+        )?;
+        let traced = crate::io::map_files::trace_cached(&slice, &sspec, None, &cache, &|_, _| {})?;
         let _ = std::fs::remove_dir_all(&cache);
         maps.push(crate::study::map::assemble(
             "fig9",

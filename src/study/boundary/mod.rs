@@ -29,8 +29,7 @@ pub use condition::{Condition, Other, Strands};
 use crate::model::rod::Parameter;
 use crate::scene::MapSpec;
 use crate::scene::Scene;
-use crate::study::map::Line;
-use anyhow::{Context, Result};
+use crate::study::error::{Context, Result, fail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 pub use walk::trace_island;
@@ -111,41 +110,6 @@ impl Traced {
             grid_check: None,
         }
     }
-}
-
-/// The traced boundary of a map, read from `cache/trace.json` when an earlier
-/// (interrupted) run of the same scene and N wrote it, else traced and
-/// written there.
-pub fn trace_cached(
-    scene: &Scene,
-    spec: &MapSpec,
-    segments: Option<usize>,
-    cache: &std::path::Path,
-    on_point: &dyn Fn(usize, &str),
-) -> Result<Traced> {
-    #[derive(Serialize, Deserialize)]
-    struct Cached {
-        key: String,
-        traced: Traced,
-    }
-    std::fs::create_dir_all(cache).with_context(|| format!("creating {}", cache.display()))?;
-    let file = cache.join("trace.json");
-    // a walk depends on the whole scene (model, start, map settings) and N
-    let key = serde_json::to_string(&(scene, spec, segments))?;
-    if let Some(c) = std::fs::read_to_string(&file)
-        .ok()
-        .and_then(|t| serde_json::from_str::<Cached>(&t).ok())
-        && c.key == key
-    {
-        return Ok(c.traced);
-    }
-    let traced = trace_island(scene, spec, segments, on_point)
-        .unwrap_or_else(|e| Traced::failed(format!("{e:#}")));
-    let tmp = file.with_extension("json.tmp");
-    let cached = Cached { key, traced };
-    std::fs::write(&tmp, serde_json::to_vec(&cached)?)?;
-    std::fs::rename(&tmp, &file)?;
-    Ok(cached.traced)
 }
 
 /// Two crossing conditions of the same strands, up to a few segments.
@@ -262,39 +226,6 @@ pub(crate) fn finish(
         }
     }
     traced
-}
-
-/// Compare a closed traced loop with the grid's good intervals: each line's
-/// interval ends against the loop's crossings of that line.
-pub fn grid_check(traced: &Traced, lines: &[Line]) -> Option<GridCheck> {
-    if !traced.closed {
-        return None;
-    }
-    let (mut ends, mut worst, mut other) = (0, 0.0f64, Vec::new());
-    for l in lines {
-        let v = l.value;
-        let cuts = traced.cuts(v);
-        let grid: Vec<f64> = l.intervals.iter().flat_map(|i| [i.lo, i.hi]).collect();
-        if cuts.len() != grid.len() {
-            other.push(v);
-        }
-        if cuts.is_empty() {
-            continue;
-        }
-        for e in grid {
-            let d = cuts
-                .iter()
-                .map(|c| (c - e).abs())
-                .fold(f64::INFINITY, f64::min);
-            worst = worst.max(d);
-            ends += 1;
-        }
-    }
-    Some(GridCheck {
-        ends,
-        max_phi_deviation: worst,
-        lines_with_other_count: other,
-    })
 }
 
 #[cfg(test)]

@@ -11,8 +11,8 @@ use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::MapSpec;
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
+use crate::study::error::{Context, Result, StudyError, describe, fail};
 use crate::study::start::starting_equilibrium;
-use anyhow::{Context, Result, bail};
 
 #[derive(Clone)]
 struct Site {
@@ -88,7 +88,7 @@ impl Walk<'_, '_> {
     /// The equilibrium at `p`, continued from the equilibrium `state` at `from`.
     fn settle_from(&mut self, state: &RodState, from: [f64; 2], p: [f64; 2]) -> Result<Site> {
         if !(p[0].is_finite() && p[1].is_finite()) {
-            bail!("boundary walk: non-finite parameters");
+            fail!("boundary walk: non-finite parameters");
         }
         let moves = ((p[0] - from[0]).abs().max((p[1] - from[1]).abs()) / SUBSTEP).ceil();
         let moves = (moves as usize).max(1);
@@ -158,7 +158,7 @@ impl Walk<'_, '_> {
             Condition::Stability => {
                 let energy = &self.tracer.newton.energy;
                 if energy.model.law.constrained() {
-                    bail!(
+                    fail!(
                         "boundary walk: a stability boundary of a constrained law \
                          (lowest eigenvalue on the constraints' tangent space) is not traced"
                     );
@@ -192,7 +192,7 @@ impl Walk<'_, '_> {
             *gk = (self.value(c, &s)? - g0) / h;
         }
         if !(g[0].is_finite() && g[1].is_finite()) || g == [0.0, 0.0] {
-            bail!(
+            fail!(
                 "boundary walk: the condition {} has no gradient",
                 c.describe()
             );
@@ -287,7 +287,7 @@ impl Walk<'_, '_> {
         for it in 1..=12 {
             let root = s - g / slope;
             if !root.is_finite() || root.abs() > limit {
-                bail!("corrector left the neighbourhood of {}", c.describe());
+                fail!("corrector left the neighbourhood of {}", c.describe());
             }
             if (root - last_root).abs() <= CORRECTOR_TOL
                 || (offset == 0.0 && (root - s).abs() <= CORRECTOR_TOL)
@@ -306,7 +306,7 @@ impl Walk<'_, '_> {
             }
             (s, g, site, last_root) = (target, gn, next, root);
         }
-        bail!("corrector on {} did not converge", c.describe())
+        fail!("corrector on {} did not converge", c.describe())
     }
 
     /// The point of `c` a distance `s` along the tangent from the walk's
@@ -356,7 +356,7 @@ pub fn trace_island(
         .as_ref()
         .context("[map] needs a [continuation] in φ")?;
     if spec.parameter == Parameter::Phi {
-        bail!("map.parameter: the boundary is traced in (parameter, φ); it cannot be φ");
+        fail!("map.parameter: the boundary is traced in (parameter, φ); it cannot be φ");
     }
     let (mut newton, state, _) = starting_equilibrium(scene, segments)?;
     let mut tracer = Tracer::new(&mut newton, Parameter::Phi, cont.settings());
@@ -372,7 +372,7 @@ pub fn trace_island(
     };
     let p0 = [spec.parameter.value(&base), base.phi_over_2pi()];
     if !walk.inside(spec.trace_from.unwrap_or(p0)) {
-        bail!(
+        fail!(
             "the boundary walk's start ({} = {}, φ/2π = {}: map.trace_from or the scene's \
              start) lies outside the map's range",
             spec.parameter.name(),
@@ -393,7 +393,7 @@ pub fn trace_island(
         _ => (start, p0),
     };
     if let Some(f) = walk.failing(&start, None, [0.0, 0.0])? {
-        bail!(
+        fail!(
             "the boundary walk starts from a good knot (map.trace_from, or the scene's start); \
              at {} = {}, φ/2π = {} {f}",
             spec.parameter.name(),
@@ -403,7 +403,7 @@ pub fn trace_island(
     }
     let mut pieces: Vec<Trail> = Vec::new();
     let outcome = walk_around(&mut walk, start, &mut pieces, on_point);
-    let stopped = outcome.err().map(|e| format!("{e:#}"));
+    let stopped = outcome.err().map(|e| describe(&e));
     let closed = stopped.is_none();
     Ok(finish(walk.swept, walk.equilibria, pieces, closed, stopped))
 }
@@ -421,7 +421,7 @@ fn walk_around(
     let bad = loop {
         let p = along(good.p, up, SUBSTEP);
         if !walk.inside(p) {
-            bail!("no boundary above the start within the map's φ range");
+            fail!("no boundary above the start within the map's φ range");
         }
         let s = walk.settle(&good, p)?;
         match walk.failing(&s, None, up)? {
@@ -455,7 +455,7 @@ fn walk_around(
     let mut tried: Vec<Strands> = Vec::new();
     loop {
         if count >= MAX_POINTS || walk.equilibria >= MAX_EQUILIBRIA {
-            bail!(
+            fail!(
                 "boundary walk: {count} points and {} equilibria without closing, at ({:.5}, {:.5})",
                 walk.equilibria,
                 at.site.on[0],
@@ -477,10 +477,8 @@ fn walk_around(
                 if sigma < MIN_STEP {
                     let why = other
                         .err()
-                        .map_or("the boundary turns too sharply".into(), |e| {
-                            format!("{e:#}")
-                        });
-                    bail!(
+                        .map_or("the boundary turns too sharply".into(), |e| describe(&e));
+                    fail!(
                         "boundary walk stopped on {} at ({:.5}, {:.5}): {why}",
                         c.describe(),
                         at.site.p[0],
@@ -491,7 +489,7 @@ fn walk_around(
             }
         };
         if !walk.inside(q.p) {
-            bail!(
+            fail!(
                 "the good region reaches the map's range at ({:.5}, {:.5})",
                 q.p[0],
                 q.p[1]
@@ -567,7 +565,7 @@ fn walk_around(
                     tried.push(s);
                 }
                 if stuck > 12 {
-                    bail!(
+                    fail!(
                         "boundary walk stuck at a corner of {} at ({:.5}, {:.5})",
                         c.describe(),
                         good.on[0],

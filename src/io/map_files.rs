@@ -1,0 +1,177 @@
+//! A map's files: its computed lines and traced boundary kept beside the
+//! output (an interrupted map resumes from them), and the partial results of
+//! shards and their merge.
+
+use crate::scene::{MapSpec, Scene};
+use crate::study::boundary::{Traced, trace_island};
+use crate::study::error::{StudyError, describe};
+use crate::study::map::{Line, LineStore, Map, assemble};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A map file that could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum MapFileError {
+    /// A file or folder could not be read or written.
+    #[error("{what} {}", path.display())]
+    File {
+        /// What was being done ("cannot read", "creating", "writing").
+        what: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file that is not what it should be.
+    #[error("{} is not {what}", path.display())]
+    Format {
+        /// What it should be.
+        what: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// The parser's message.
+        #[source]
+        source: serde_json::Error,
+    },
+    /// Shards do not make a whole map.
+    #[error("{0}")]
+    Merge(String),
+    /// A result that could not be encoded as JSON.
+    #[error("encoding JSON: {0}")]
+    Encode(#[from] serde_json::Error),
+    /// The study behind the file failed.
+    #[error(transparent)]
+    Study(#[from] StudyError),
+}
+
+fn file_error(what: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> MapFileError {
+    let path = path.to_path_buf();
+    move |source| MapFileError::File { what, path, source }
+}
+
+/// Write `bytes` to `file` through a temporary file renamed into place, so a
+/// reader never sees half a file.
+fn write_atomically(file: &Path, bytes: &[u8]) -> Result<(), MapFileError> {
+    let tmp = file.with_extension("json.tmp");
+    std::fs::write(&tmp, bytes).map_err(file_error("writing", &tmp))?;
+    std::fs::rename(&tmp, file).map_err(file_error("writing", file))
+}
+
+/// The lines of a map kept as `line_KKKKK.json` in a folder.
+pub struct LineFolder {
+    folder: PathBuf,
+}
+
+impl LineFolder {
+    /// The folder (created if need be).
+    pub fn create(folder: &Path) -> Result<Self, MapFileError> {
+        std::fs::create_dir_all(folder).map_err(file_error("creating", folder))?;
+        Ok(LineFolder {
+            folder: folder.to_path_buf(),
+        })
+    }
+
+    fn file(&self, index: usize) -> PathBuf {
+        self.folder.join(format!("line_{index:05}.json"))
+    }
+}
+
+impl LineStore for LineFolder {
+    fn get(&self, index: usize, value: f64) -> Option<Line> {
+        std::fs::read_to_string(self.file(index))
+            .ok()
+            .and_then(|t| serde_json::from_str::<Line>(&t).ok())
+            .filter(|l| l.index == index && l.value == value)
+    }
+
+    fn put(&self, line: &Line) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+        let bytes = serde_json::to_vec(line)?;
+        write_atomically(&self.file(line.index), &bytes)?;
+        Ok(())
+    }
+}
+
+/// The traced boundary of a map, read from `cache/trace.json` when an earlier
+/// (interrupted) run of the same scene and N wrote it, else traced and
+/// written there. A walk that fails is a traced boundary that says why.
+pub fn trace_cached(
+    scene: &Scene,
+    spec: &MapSpec,
+    segments: Option<usize>,
+    cache: &Path,
+    on_point: &dyn Fn(usize, &str),
+) -> Result<Traced, MapFileError> {
+    #[derive(Serialize, Deserialize)]
+    struct Cached {
+        key: String,
+        traced: Traced,
+    }
+    std::fs::create_dir_all(cache).map_err(file_error("creating", cache))?;
+    let file = cache.join("trace.json");
+    // a walk depends on the whole scene (model, start, map settings) and N
+    let key = serde_json::to_string(&(scene, spec, segments))?;
+    if let Some(c) = std::fs::read_to_string(&file)
+        .ok()
+        .and_then(|t| serde_json::from_str::<Cached>(&t).ok())
+        && c.key == key
+    {
+        return Ok(c.traced);
+    }
+    let traced = trace_island(scene, spec, segments, on_point)
+        .unwrap_or_else(|e| Traced::failed(describe(&e)));
+    let cached = Cached { key, traced };
+    let bytes = serde_json::to_vec(&cached)?;
+    write_atomically(&file, &bytes)?;
+    Ok(cached.traced)
+}
+
+/// A partial result of shard i/n.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Partial {
+    /// Scene name.
+    pub scene: String,
+    /// The map settings.
+    pub spec: MapSpec,
+    /// φ range of the lines.
+    pub phi_range: [f64; 2],
+    /// Shard (i, n).
+    pub shard: (usize, usize),
+    /// Its lines.
+    pub lines: Vec<Line>,
+    /// The traced boundary (shard 0 computes it).
+    #[serde(default)]
+    pub traced: Option<Traced>,
+}
+
+/// Merge partial results into a map.
+pub fn merge(parts: &[PathBuf]) -> Result<Map, MapFileError> {
+    let mut all = Vec::new();
+    let mut head: Option<Partial> = None;
+    let mut traced = None;
+    for p in parts {
+        let text = std::fs::read_to_string(p).map_err(file_error("cannot read", p))?;
+        let part: Partial = serde_json::from_str(&text).map_err(|source| MapFileError::Format {
+            what: "a partial map",
+            path: p.clone(),
+            source,
+        })?;
+        all.extend(part.lines.clone());
+        if part.traced.is_some() {
+            traced = part.traced.clone();
+        }
+        head.get_or_insert(part);
+    }
+    let h =
+        head.ok_or_else(|| MapFileError::Merge("merge needs at least one partial result".into()))?;
+    let map = assemble(&h.scene, &h.spec, h.phi_range, all, traced);
+    let missing: Vec<usize> = (0..h.spec.lines)
+        .filter(|k| !map.lines.iter().any(|l| l.index == *k))
+        .collect();
+    if !missing.is_empty() {
+        return Err(MapFileError::Merge(format!(
+            "merge: lines {missing:?} are missing (a shard was not merged)"
+        )));
+    }
+    Ok(map)
+}
