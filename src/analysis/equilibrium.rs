@@ -5,7 +5,6 @@ use crate::analysis::class::{good_knot, is_trefoil};
 use crate::geometry::closure::{closure_knot, ray_closure, reach};
 use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
 use crate::geometry::knot::KnotType;
-use crate::geometry::walls::wall_clearance;
 use crate::geometry::writhe::writhe_closed;
 use crate::linalg::eigen::StabilityError;
 use crate::linalg::eigen::lowest_eigenvalues;
@@ -170,8 +169,7 @@ impl Shape {
         // curve's neighbourhood
         let reach = reach(&points);
         let self_approach = min_self_distance(&points, &arc, measure.self_distance_gap);
-        let heights: Vec<f64> = points[1..points.len() - 1].iter().map(|p| p.z).collect();
-        let wall_distance = wall_clearance(&heights, state.clamps.z_star);
+        let wall_distance = state.wall_clearance();
         let end = *points.last().unwrap();
         let gap = measure.self_distance_gap;
         let ray = |origin: &Vector3<f64>, dir: Vector3<f64>, s_base: f64| {

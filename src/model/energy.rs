@@ -12,7 +12,7 @@
 use crate::linalg::jet::{self, Jet3, Jet4, Jet8};
 use crate::linalg::sparse::{NO_SLOT, SymmetricPattern};
 use crate::model::frames::{self, Scalar, V3, lift};
-use crate::model::rod::{DofMap, Law, RodModel, RodState, tangent};
+use crate::model::rod::{ClampVelocity, DofMap, Law, RodModel, RodState, tangent};
 use nalgebra::Vector3;
 
 /// Which energy terms to include.
@@ -741,16 +741,6 @@ impl RodEnergy {
             out[i - 1] = rows[i - 1].1.iter().zip(&vel).map(|(g, v)| g * v).sum();
         }
     }
-}
-
-/// Velocity of the s = 1 clamp's dofs with respect to a loading parameter:
-/// both clamp nodes translate by `end`, the clamp angle turns by `theta`.
-#[derive(Clone, Copy, Debug)]
-pub struct ClampVelocity {
-    /// d(end point)/dp.
-    pub end: Vector3<f64>,
-    /// dφ/dp.
-    pub theta: f64,
 }
 
 impl RodEnergy {

@@ -7,10 +7,21 @@
 //! midpoint rule and the scheme stays second order. Fixed: nodes 0, 1, N, N+1
 //! and the material angles of edges 0 and N.
 
+use crate::geometry::walls::wall_clearance;
 use crate::model::frames::{self, V3};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
+
+/// Velocity of the s = 1 clamp's dofs with respect to a loading parameter:
+/// both clamp nodes translate by `end`, the clamp angle turns by `theta`.
+#[derive(Clone, Copy, Debug)]
+pub struct ClampVelocity {
+    /// d(end point)/dp.
+    pub end: Vector3<f64>,
+    /// dφ/dp.
+    pub theta: f64,
+}
 
 /// Material and discretisation parameters of a rod.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -405,6 +416,14 @@ impl RodState {
             .fold(0.0, f64::max)
     }
 
+    /// Clearance of the interior extrema of z from the walls z = 0 and z = z*
+    /// (negative: outside; see [`wall_clearance`]).
+    pub fn wall_clearance(&self) -> f64 {
+        let (points, _) = self.centreline();
+        let heights: Vec<f64> = points[1..points.len() - 1].iter().map(|p| p.z).collect();
+        wall_clearance(&heights, self.clamps.z_star)
+    }
+
     /// Interior node heights: (min z, max z) over nodes 1..=N (s in (0,1)).
     pub fn z_range(&self) -> (f64, f64) {
         let n = self.segments();
@@ -506,7 +525,7 @@ impl Parameter {
     }
 
     /// How the clamp's dofs move with the parameter.
-    pub fn velocity(&self, c: &Clamps) -> crate::model::energy::ClampVelocity {
+    pub fn velocity(&self, c: &Clamps) -> ClampVelocity {
         let half = c.phi / 2.0;
         let (end, theta) = match self {
             Parameter::ZStar => (Vector3::z(), 0.0),
@@ -516,7 +535,7 @@ impl Parameter {
                 2.0 * PI,
             ),
         };
-        crate::model::energy::ClampVelocity { end, theta }
+        ClampVelocity { end, theta }
     }
 
     /// Name as in summaries.

@@ -521,3 +521,25 @@ impl Scene {
         )
     }
 }
+
+// a slice of a 3D map is a scene: built here, where scenes are
+impl SliceSpec {
+    /// The scene of slice k: its parameter set, its start φ.
+    pub fn scene(&self, scene: &Scene, k: usize) -> Scene {
+        let mut s = scene.clone();
+        let c = self.parameter.with(&scene.clamps(), self.values[k]);
+        s.clamps.z_star = c.z_star;
+        s.clamps.delta = c.delta;
+        s.clamps.phi_over_2pi = c.phi_over_2pi();
+        if let Some(p) = &self.start_phi_over_2pi {
+            s.clamps.phi_over_2pi = p[k];
+        }
+        if let Some(m) = s.map.as_mut() {
+            m.slices = None;
+            if let Some(t) = &self.trace_from {
+                m.trace_from = Some(t[k]);
+            }
+        }
+        s
+    }
+}

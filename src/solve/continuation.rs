@@ -7,11 +7,12 @@
 //! bordered in, stability from the inertia reduced to the tangent space.
 
 use crate::linalg::sparse::Ldlt;
-use crate::model::energy::ClampVelocity;
+use crate::model::rod::ClampVelocity;
 use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::solve::kkt::Kkt;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::{SolveError, residual};
+use crate::solve::step::StepControl;
 use serde::{Deserialize, Serialize};
 
 /// Settings of one continuation.
@@ -32,6 +33,14 @@ pub struct ContinuationSettings {
     pub max_corrector_iterations: usize,
     /// Events are located to this arclength.
     pub locate_tolerance: f64,
+}
+
+impl ContinuationSettings {
+    /// Its step control: from `step`, halved on failure down to `min_step`,
+    /// ×1.5 after a corrector of at most 3 iterations, up to `max_step`.
+    pub fn step_control(&self) -> StepControl {
+        StepControl::new(self.step, self.min_step, self.max_step, 1.5, 3)
+    }
 }
 
 impl Default for ContinuationSettings {

@@ -8,3 +8,4 @@ pub mod minimizer;
 pub mod newton;
 pub mod outcome;
 pub mod sqp;
+pub mod step;

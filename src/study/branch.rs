@@ -9,7 +9,7 @@ use crate::model::rod::{Parameter, RodState};
 use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
-use crate::study::error::{Context, Result, fail};
+use crate::study::error::{Context, Result};
 
 /// Test functions watched along a branch.
 #[derive(Clone, Debug)]
@@ -27,13 +27,6 @@ impl Watch {
             link: eq.link,
         }
     }
-}
-
-/// Wall clearance of a state (the cheap part of [`Shape`]).
-fn wall_of(state: &RodState) -> f64 {
-    let (points, _) = state.centreline();
-    let heights: Vec<f64> = points[1..points.len() - 1].iter().map(|p| p.z).collect();
-    crate::geometry::walls::wall_clearance(&heights, state.clamps.z_star)
 }
 
 /// Knot determinant and link of a state.
@@ -184,12 +177,12 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             (self.observer)(eq)?;
         }
         let mut a = start;
-        let mut ds = settings.step;
+        let mut step = settings.step_control();
         for _ in 0..settings.max_points {
             if !self.in_range(&a) {
                 break;
             }
-            let b = match self.tracer.correct(&a, ds, None) {
+            let b = match self.tracer.correct(&a, step.length, None) {
                 // few corrector iterations, a small correction and a small
                 // turn of the tangent: the step stayed on this part of the branch
                 Ok(b)
@@ -198,8 +191,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                     b
                 }
                 _ => {
-                    ds *= 0.5;
-                    if ds < settings.min_step {
+                    if !step.shrink() {
                         self.events.push(event(
                             EventKind::End,
                             &a,
@@ -214,12 +206,10 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             let eq = self.measure(&b, branch, leg)?;
             let wb = Watch::of(&eq);
             if self.options.locate_events {
-                self.locate_events(&a, &b, &wa, &wb, ds, branch)?;
+                self.locate_events(&a, &b, &wa, &wb, step.length, branch)?;
             }
             (self.observer)(eq)?;
-            if b.iterations <= 3 {
-                ds = (ds * 1.5).min(settings.max_step);
-            }
+            step.accepted(b.iterations);
             a = b;
             wa = wb;
         }
@@ -292,7 +282,9 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         if (wa.wall > 0.0) != (wb.wall > 0.0) {
             let inside = wa.wall > 0.0;
             let p = self
-                .locate(a, ds, &mut |_, p| (wall_of(&p.state) > 0.0) == inside)
+                .locate(a, ds, &mut |_, p| {
+                    (p.state.wall_clearance() > 0.0) == inside
+                })
                 .context("locating a wall")?;
             let detail = if inside {
                 "leaves the walls"

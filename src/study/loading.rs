@@ -82,15 +82,6 @@ pub fn settle(
     fail!("could not reach a stable equilibrium from a saddle")
 }
 
-/// Largest node distance between two states.
-fn max_move(a: &RodState, b: &RodState) -> f64 {
-    a.nodes
-        .iter()
-        .zip(&b.nodes)
-        .map(|(x, y)| (x - y).norm())
-        .fold(0.0, f64::max)
-}
-
 fn eq_clamps(eq: &crate::analysis::equilibrium::Equilibrium) -> Clamps {
     eq.state.clamps
 }
@@ -103,7 +94,7 @@ fn predict(newton: &mut Minimizer, state: &RodState, c: Clamps) -> Result<RodSta
     let mut g = vec![0.0; n];
     let mut v = vec![0.0; e.pattern.nnz()];
     e.hessian(state, &mut g, &mut v);
-    let velocity = crate::model::energy::ClampVelocity {
+    let velocity = crate::model::rod::ClampVelocity {
         end: c.end_point() - state.clamps.end_point(),
         theta: c.phi - state.clamps.phi,
     };
@@ -152,10 +143,10 @@ pub fn carry(
     settings: &SolverSettings,
 ) -> Result<Step> {
     let predicted = predict(newton, state, c)?;
-    let predicted_move = max_move(&predicted, state);
+    let predicted_move = predicted.largest_node_distance(state);
     let mut next = predicted.clone();
     let report = settle(newton, &mut next, settings)?;
-    let miss = max_move(&next, &predicted);
+    let miss = next.largest_node_distance(&predicted);
     Ok(Step {
         state: next,
         report,

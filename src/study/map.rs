@@ -12,12 +12,11 @@ use crate::analysis::event::{Event, EventKind};
 use crate::scene::{MapSpec, Scene, SliceSpec};
 use crate::study::boundary::{GridCheck, Traced};
 use crate::study::branch::{BranchOptions, BranchRun};
-use crate::study::error::{Context, Result, StudyError, describe, fail};
+use crate::study::error::{Context, Result, StudyError, describe};
 use crate::study::run::reach;
 use crate::study::start::starting_equilibrium;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
 
 /// A point of a line of the map.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]

@@ -29,14 +29,13 @@ pub fn reach(
     }
     let sign = (target - now).signum();
     let mut a = tracer.start(state, sign).context("tangent at the start")?;
-    let mut ds = settings.step;
+    let mut step = settings.step_control();
     for _ in 0..settings.max_points {
         let pa = tracer.parameter_of(&a.state);
-        let b = match tracer.correct(&a, ds, None) {
+        let b = match tracer.correct(&a, step.length, None) {
             Ok(b) if b.iterations <= 6 => b,
             _ => {
-                ds *= 0.5;
-                if ds < settings.min_step {
+                if !step.shrink() {
                     fail!(
                         "could not reach {} = {target}: branch lost at {pa}",
                         parameter.name()
@@ -51,7 +50,7 @@ pub fn reach(
             // parameter: a corrector along the parameter axis
             let below = (pa - target).signum();
             let near = tracer
-                .locate(&a, ds, &mut |t, p| {
+                .locate(&a, step.length, &mut |t, p| {
                     (t.parameter_of(&p.state) - target).signum() == below
                 })
                 .context("locating the target value")?;
@@ -66,9 +65,7 @@ pub fn reach(
                 .context("Newton at the target value")?;
             return Ok(p.state);
         }
-        if b.iterations <= 3 {
-            ds = (ds * 1.5).min(settings.max_step);
-        }
+        step.accepted(b.iterations);
         a = b;
     }
     fail!(

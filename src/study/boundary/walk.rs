@@ -2,8 +2,6 @@
 //! pseudo-arclength continuation in the plane, corners where another property
 //! fails, equilibria by Newton at fixed clamps.
 
-use super::condition::{Condition, Failure, Other, Strands, closest_strands, strand_distance};
-use super::{Traced, Trail, finish};
 use crate::analysis::class::is_trefoil;
 use crate::analysis::equilibrium::Measure;
 use crate::geometry::closure::closure_knot;
@@ -11,7 +9,11 @@ use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::MapSpec;
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
-use crate::study::error::{Context, Result, StudyError, describe, fail};
+use crate::study::boundary::condition::{
+    Condition, Failure, Other, Strands, closest_strands, strand_distance,
+};
+use crate::study::boundary::traced::{Traced, Trail, name_pieces};
+use crate::study::error::{Context, Result, describe, fail};
 use crate::study::start::starting_equilibrium;
 
 #[derive(Clone)]
@@ -405,7 +407,13 @@ pub fn trace_island(
     let outcome = walk_around(&mut walk, start, &mut pieces, on_point);
     let stopped = outcome.err().map(|e| describe(&e));
     let closed = stopped.is_none();
-    Ok(finish(walk.swept, walk.equilibria, pieces, closed, stopped))
+    Ok(name_pieces(
+        walk.swept,
+        walk.equilibria,
+        pieces,
+        closed,
+        stopped,
+    ))
 }
 
 /// Move up in φ from `start` to the first boundary, then walk around.

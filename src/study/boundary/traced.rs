@@ -1,0 +1,237 @@
+//! The traced boundary: the walk's pieces named as the paper does (W1, W2,
+//! X1, X2, S), the loop's area and extent.
+
+use crate::model::rod::Parameter;
+use crate::study::boundary::condition::Condition;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// A piece of the walk: its condition, and its points with the φ component
+/// of the condition's unit gradient (positive: the good side lies above).
+pub(super) type Trail = (Condition, Vec<([f64; 2], f64)>);
+
+/// One piece of the traced boundary: a polyline on one condition.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Piece {
+    /// Paper-style name (W1, W2, X, X1, S, ...).
+    pub label: String,
+    /// The condition followed.
+    pub condition: String,
+    /// Points (swept parameter, φ/2π) in walk order (good region on the left).
+    pub points: Vec<[f64; 2]>,
+}
+
+/// How the traced boundary compares with the grid of one-parameter branches.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct GridCheck {
+    /// Grid interval ends compared (lines whose value the loop spans).
+    pub ends: usize,
+    /// Largest |φ/2π(grid end) − φ/2π(nearest boundary crossing of that line)|.
+    pub max_phi_deviation: f64,
+    /// Lines where the loop and the grid count different interval ends.
+    pub lines_with_other_count: Vec<f64>,
+}
+
+/// The island's boundary traced by two-parameter continuation.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Traced {
+    /// The pieces in walk order.
+    pub pieces: Vec<Piece>,
+    /// The walk came back to its start.
+    pub closed: bool,
+    /// Area enclosed (closed walks only).
+    pub area: Option<f64>,
+    /// Extent of the traced boundary: {parameter: [lo, hi], "phi_over_2pi": [lo, hi]}.
+    pub bounding_box: BTreeMap<String, [f64; 2]>,
+    /// Points of the pieces (a corner counts in both its pieces).
+    pub points: usize,
+    /// Equilibria solved (Newton at fixed clamps).
+    pub equilibria: usize,
+    /// Why the walk stopped before closing, if it did.
+    pub stopped: Option<String>,
+    /// Comparison with the grid's good intervals.
+    #[serde(default)]
+    pub grid_check: Option<GridCheck>,
+}
+
+impl Traced {
+    /// The pieces' points joined in walk order.
+    pub fn polygon(&self) -> Vec<[f64; 2]> {
+        self.pieces.iter().flat_map(|p| p.points.clone()).collect()
+    }
+
+    /// φ/2π where the traced loop crosses the line (swept parameter = v).
+    pub fn cuts(&self, v: f64) -> Vec<f64> {
+        self.polygon()
+            .windows(2)
+            .filter(|w| (w[0][0] <= v) != (w[1][0] <= v))
+            .map(|w| w[0][1] + (v - w[0][0]) / (w[1][0] - w[0][0]) * (w[1][1] - w[0][1]))
+            .collect()
+    }
+
+    /// A walk that could not start.
+    pub fn failed(why: String) -> Self {
+        Traced {
+            pieces: vec![],
+            closed: false,
+            area: None,
+            bounding_box: BTreeMap::new(),
+            points: 0,
+            equilibria: 0,
+            stopped: Some(why),
+            grid_check: None,
+        }
+    }
+}
+
+/// Two crossing conditions of the same strands, up to a few segments.
+fn same_crossing(a: &Condition, b: &Condition) -> bool {
+    match (a, b) {
+        (Condition::Crossing(a), Condition::Crossing(b)) => a.near(b.first, b.other),
+        _ => false,
+    }
+}
+
+/// The paper's name of a piece: walls are W1 where the good region lies
+/// above them in φ, W2 where it lies below.
+fn label(c: &Condition, side: f64) -> &'static str {
+    match c {
+        Condition::Wall if side >= 0.0 => "W1",
+        Condition::Wall => "W2",
+        Condition::Crossing(_) => "X",
+        Condition::Stability => "S",
+    }
+}
+
+/// Name the pieces as the paper does and measure the loop.
+pub(super) fn name_pieces(
+    swept: Parameter,
+    equilibria: usize,
+    pieces: Vec<Trail>,
+    closed: bool,
+    stopped: Option<String>,
+) -> Traced {
+    // a crossing followed across neighbouring segment pairs (a corner where
+    // the knot test flickered at a sharp tip) is one curve
+    let mut pieces = pieces;
+    let mut k = 1;
+    while k < pieces.len() {
+        if same_crossing(&pieces[k - 1].0, &pieces[k].0) {
+            let next = pieces.remove(k);
+            pieces[k - 1].1.extend(next.1.into_iter().skip(1));
+        } else {
+            k += 1;
+        }
+    }
+    // split the pieces where their name changes (a wall curve turning round
+    // the island's tip is W1 on one side and W2 on the other)
+    let mut named: Vec<Piece> = Vec::new();
+    for (c, points) in &pieces {
+        let piece = |name: &str, p: [f64; 2]| Piece {
+            label: name.into(),
+            condition: c.describe(),
+            points: vec![p],
+        };
+        let mut current = piece(label(c, points[0].1), points[0].0);
+        for (k, &(p, side)) in points.iter().enumerate().skip(1) {
+            current.points.push(p);
+            // the piece's last point (a corner or the walk's start) keeps
+            // its piece's name; elsewhere a change of side starts a new one
+            let name = label(c, side);
+            if name != current.label && k + 1 < points.len() {
+                named.push(std::mem::replace(&mut current, piece(name, p)));
+            }
+        }
+        named.push(current);
+    }
+    // a closed walk starts inside a piece: join its two ends
+    if closed && named.len() > 1 && named[0].label == named[named.len() - 1].label {
+        let first = named.remove(0);
+        named
+            .last_mut()
+            .unwrap()
+            .points
+            .extend(first.points.into_iter().skip(1));
+    }
+    // several pieces of one name are numbered along φ (X1, X2 as in the paper)
+    let mut by_label: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+    for (k, p) in named.iter().enumerate() {
+        by_label.entry(p.label.clone()).or_default().push(k);
+    }
+    for (label, mut ks) in by_label {
+        if ks.len() < 2 {
+            continue;
+        }
+        let mean = |p: &Piece| p.points.iter().map(|x| x[1]).sum::<f64>() / p.points.len() as f64;
+        ks.sort_by(|&a, &b| mean(&named[a]).total_cmp(&mean(&named[b])));
+        for (i, k) in ks.into_iter().enumerate() {
+            named[k].label = if label == "X" {
+                format!("X{}", i + 1)
+            } else {
+                format!("{label}.{}", i + 1)
+            };
+        }
+    }
+    let mut traced = Traced {
+        points: named.iter().map(|p| p.points.len()).sum(),
+        pieces: named,
+        closed,
+        area: None,
+        bounding_box: BTreeMap::new(),
+        equilibria,
+        stopped,
+        grid_check: None,
+    };
+    let all = traced.polygon();
+    traced.area = closed.then(|| {
+        0.5 * all
+            .windows(2)
+            .map(|w| w[0][0] * w[1][1] - w[1][0] * w[0][1])
+            .sum::<f64>()
+            .abs()
+    });
+    if !all.is_empty() {
+        for (k, name) in [swept.name(), "phi_over_2pi"].into_iter().enumerate() {
+            let lo = all.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+            let hi = all.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+            traced.bounding_box.insert(name.to_string(), [lo, hi]);
+        }
+    }
+    traced
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_wall_curve_round_the_tip_is_w1_on_one_side_and_w2_on_the_other() {
+        // a closed walk starting on the wall's upper side (good side below,
+        // W2), round the tip (W1), then a stability curve back to the start
+        let trail: Vec<Trail> = vec![
+            (
+                Condition::Wall,
+                vec![
+                    ([0.2, 0.9], -0.5),
+                    ([0.1, 0.8], -0.2),
+                    ([0.1, 0.7], 0.3),
+                    ([0.2, 0.6], 0.6),
+                ],
+            ),
+            (
+                Condition::Stability,
+                vec![([0.2, 0.6], 0.1), ([0.3, 0.8], 0.1), ([0.2, 0.9], 0.1)],
+            ),
+        ];
+        let t = name_pieces(Parameter::ZStar, 7, trail, true, None);
+        let labels: Vec<&str> = t.pieces.iter().map(|p| p.label.as_str()).collect();
+        // the walk's first piece (W2 from the start) joins its last (W2 back to
+        // the start) only when they share a name; here S closes the loop
+        assert_eq!(labels, ["W2", "W1", "S"]);
+        assert_eq!(t.pieces[0].points, vec![[0.2, 0.9], [0.1, 0.8], [0.1, 0.7]]);
+        assert_eq!(t.bounding_box["z_star"], [0.1, 0.3]);
+        // shoelace area of the polygon (0.2,0.9) (0.1,0.8) (0.1,0.7) (0.2,0.6) (0.3,0.8)
+        assert!((t.area.unwrap() - 0.035).abs() < 1e-12, "{:?}", t.area);
+        assert_eq!(t.equilibria, 7);
+    }
+}
