@@ -5,7 +5,7 @@
 //! branch end to end at N = 200.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use knotrod::analysis::equilibrium::{Measure, Shape, analyse};
+use knotrod::analysis::equilibrium::{Conformation, Measure, analyse};
 use knotrod::linalg::eigen::lowest_eigenvalues;
 use knotrod::linalg::sparse::Ldlt;
 use knotrod::model::energy::RodEnergy;
@@ -92,7 +92,7 @@ fn bench(c: &mut Criterion) {
     group("diagnostics_carried", &|_, eq| {
         let (state, previous) = (eq.state.clone(), eq.clone());
         Box::new(move || {
-            Shape::continued(&state, &measure, &previous);
+            Conformation::continued(&state, &measure, &previous);
         })
     });
     group("continuation_step", &|n, eq| {

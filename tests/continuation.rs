@@ -284,14 +284,14 @@ fn twisting_a_buckled_rod_snaps_at_two_different_angles() {
 fn settling_at_new_clamps_finds_the_equilibrium_continuation_reaches() {
     use knotrod::model::rod::{Clamps, Parameter};
     use knotrod::solve::continuation::Tracer;
-    use knotrod::study::run::reach;
+    use knotrod::study::run::continue_to;
     use knotrod::study::start::starting_equilibrium;
     let scene = Scene::load(std::path::Path::new("scenes/fig7_island_kirchhoff.toml")).unwrap();
     let settings = scene.continuation.as_ref().unwrap().settings();
     let (mut newton, start, _) = starting_equilibrium(&scene, Some(60)).unwrap();
     let target = Clamps::new(0.125, 0.05, 0.815);
     let by_path = {
-        let s = reach(
+        let s = continue_to(
             &mut newton,
             start.clone(),
             Parameter::ZStar,
@@ -299,7 +299,7 @@ fn settling_at_new_clamps_finds_the_equilibrium_continuation_reaches() {
             &settings,
         )
         .unwrap();
-        reach(&mut newton, s, Parameter::Phi, 0.815, &settings).unwrap()
+        continue_to(&mut newton, s, Parameter::Phi, 0.815, &settings).unwrap()
     };
     let mut tracer = Tracer::new(&mut newton, Parameter::Phi, settings);
     let settled = tracer.settle_at(&start, target).unwrap();

@@ -85,7 +85,7 @@ fn writhe_carried_along_a_branch_equals_the_full_writhe() {
     // Figure 3's branch at N = 100: every accepted point's writhe was carried
     // over from the previous one (Lk = n + φ/2π) unless a strand came near
     // another; recompute each from scratch and compare
-    use knotrod::analysis::equilibrium::Shape;
+    use knotrod::analysis::equilibrium::Conformation;
     let text = std::fs::read_to_string("scenes/fig3_kirchhoff.toml").unwrap();
     let text = text.replace("segments = 200", "segments = 100");
     let text = text.split("[output]").next().unwrap();
@@ -103,7 +103,7 @@ fn writhe_carried_along_a_branch_equals_the_full_writhe() {
     let measure = scene.measure();
     let mut largest = 0.0f64;
     for e in &eqs {
-        let full = Shape::of(&e.state, &measure);
+        let full = Conformation::of(&e.state, &measure);
         largest = largest.max((full.writhe - e.writhe).abs());
         assert_eq!(
             full.knot.determinant, e.knot_determinant,

@@ -132,7 +132,7 @@ pub struct Measure {
 }
 
 /// Writhe, knot type, walls and distances of a state (see [`Equilibrium`]).
-pub struct Shape {
+pub struct Conformation {
     /// Writhe of the ray closure.
     pub writhe: f64,
     /// Knot type of the ray closure.
@@ -145,9 +145,9 @@ pub struct Shape {
     pub ray_distance: [f64; 2],
 }
 
-impl Shape {
+impl Conformation {
     /// Measure the centreline of `state`.
-    pub fn of(state: &RodState, measure: &Measure) -> Shape {
+    pub fn of(state: &RodState, measure: &Measure) -> Conformation {
         Self::measure(state, measure, None)
     }
 
@@ -158,11 +158,15 @@ impl Shape {
     /// ribbon's link keeps its integer part (Călugăreanu–White: Lk = Tw + Wr
     /// = n + φ/2π), so Wr = n + φ/2π − Tw in O(N), and the knot type is
     /// unchanged. Otherwise both are computed afresh (O(N²)).
-    pub fn continued(state: &RodState, measure: &Measure, previous: &Equilibrium) -> Shape {
+    pub fn continued(state: &RodState, measure: &Measure, previous: &Equilibrium) -> Conformation {
         Self::measure(state, measure, Some(previous))
     }
 
-    fn measure(state: &RodState, measure: &Measure, previous: Option<&Equilibrium>) -> Shape {
+    fn measure(
+        state: &RodState,
+        measure: &Measure,
+        previous: Option<&Equilibrium>,
+    ) -> Conformation {
         let (points, arc) = state.centreline();
         let e3 = Vector3::z();
         // the knot type and ray distances need the rays only to leave the
@@ -216,7 +220,7 @@ impl Shape {
                 closure_knot(&points),
             ),
         };
-        Shape {
+        Conformation {
             writhe,
             knot,
             self_approach,
@@ -273,7 +277,7 @@ pub fn analyse(
 
 /// As [`analyse`], for a state reached from the measured equilibrium
 /// `previous` (the writhe and knot type are carried over when no strand can
-/// have passed through another: see [`Shape::continued`]), and with the
+/// have passed through another: see [`Conformation::continued`]), and with the
 /// Hessian at `state` when the caller has it already.
 pub fn analyse_from(
     newton: &mut Minimizer,
@@ -321,7 +325,7 @@ pub fn analyse_from(
     let (min_z, max_z) = state.z_range();
     let z_star = state.clamps.z_star;
     let stable = plain.negative_count == 0 && plain.values.first().is_none_or(|v| *v > 0.0);
-    let shape = Shape::measure(state, measure, previous);
+    let shape = Conformation::measure(state, measure, previous);
     let twist = state.twist();
     let walled = state.walled();
     let min_self_distance = shape.self_approach.map_or(f64::INFINITY, |a| a.distance);

@@ -1,7 +1,7 @@
 //! `knotrod bench`: standard workloads timed with their work counts, and the
 //! growth of per-step costs with N (fitted exponents).
 
-use crate::analysis::equilibrium::Shape;
+use crate::analysis::equilibrium::Conformation;
 use crate::geometry::closure::ray_closure;
 use crate::geometry::distance::min_self_distance;
 use crate::geometry::knot::knot_type;
@@ -241,13 +241,13 @@ pub fn run(scenes: &Path) -> Result<Report> {
         push(
             "diagnostics_per_step",
             per_call(|| {
-                Shape::continued(&state, &m, &e);
+                Conformation::continued(&state, &m, &e);
             }),
         );
         push(
             "diagnostics_full",
             per_call(|| {
-                Shape::of(&state, &m);
+                Conformation::of(&state, &m);
             }),
         );
     }

@@ -3,7 +3,7 @@
 //! points (S), walls touched (W), self-crossings (X) and knot changes — and the
 //! bifurcating branches followed from branch points when asked.
 
-use crate::analysis::equilibrium::{Equilibrium, Measure, Shape, analyse_from};
+use crate::analysis::equilibrium::{Conformation, Equilibrium, Measure, analyse_from};
 use crate::analysis::event::{Event, EventKind};
 use crate::model::rod::{Parameter, RodState};
 use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
@@ -13,15 +13,15 @@ use crate::study::error::{Context, Result};
 
 /// Test functions watched along a branch.
 #[derive(Clone, Debug)]
-struct Watch {
+struct TestValues {
     wall: f64,
     knot: u64,
     link: f64,
 }
 
-impl Watch {
-    fn of(eq: &Equilibrium) -> Watch {
-        Watch {
+impl TestValues {
+    fn of(eq: &Equilibrium) -> TestValues {
+        TestValues {
             wall: eq.wall_distance,
             knot: eq.knot_determinant,
             link: eq.link,
@@ -31,7 +31,7 @@ impl Watch {
 
 /// Knot determinant and link of a state.
 fn knot_of(state: &RodState, measure: &Measure) -> (u64, f64) {
-    let shape = Shape::of(state, measure);
+    let shape = Conformation::of(state, measure);
     (shape.knot.determinant, state.twist() + shape.writhe)
 }
 
@@ -130,7 +130,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
 
     /// Follow the branch through `state` in both directions (or one: sign ±1),
     /// then, if asked, the branches bifurcating at its branch points.
-    pub fn run(&mut self, state: RodState, directions: &[f64]) -> Result<()> {
+    pub fn follow(&mut self, state: RodState, directions: &[f64]) -> Result<()> {
         let branch = self.next_branch;
         self.next_branch += 1;
         for (k, &sign) in directions.iter().enumerate() {
@@ -172,7 +172,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
     fn trace(&mut self, start: Point, branch: usize, leg: usize, emit_start: bool) -> Result<()> {
         let settings = self.options.settings.clone();
         let eq = self.measure(&start, branch, leg)?;
-        let mut wa = Watch::of(&eq);
+        let mut wa = TestValues::of(&eq);
         if emit_start {
             (self.observer)(eq)?;
         }
@@ -204,7 +204,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 }
             };
             let eq = self.measure(&b, branch, leg)?;
-            let wb = Watch::of(&eq);
+            let wb = TestValues::of(&eq);
             if self.options.locate_events {
                 self.locate_events(&a, &b, &wa, &wb, step.length, branch)?;
             }
@@ -231,8 +231,8 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         &mut self,
         a: &Point,
         b: &Point,
-        wa: &Watch,
-        wb: &Watch,
+        wa: &TestValues,
+        wb: &TestValues,
         ds: f64,
         branch: usize,
     ) -> Result<()> {

@@ -42,7 +42,7 @@ fn inertia(newton: &mut Minimizer, state: &RodState, want_mode: bool) -> Result<
 
 /// Minimise from `state` and make sure the result is a minimum: from a saddle,
 /// step off along the unstable mode (both ways tried, the lower energy kept).
-pub fn settle(
+pub fn minimize_to_stable(
     newton: &mut Minimizer,
     state: &mut RodState,
     settings: &SolverSettings,
@@ -136,7 +136,7 @@ pub struct Step {
 /// Move the clamps of the equilibrium `state` to `c` and settle: first-order
 /// prediction along the branch (dq = −H⁻¹ ∂_p∇E), then minimisation. A smooth
 /// branch lands within second order of the prediction; a jump lands far away.
-pub fn carry(
+pub fn move_clamps(
     newton: &mut Minimizer,
     state: &RodState,
     c: Clamps,
@@ -145,7 +145,7 @@ pub fn carry(
     let predicted = predict(newton, state, c)?;
     let predicted_move = predicted.largest_node_distance(state);
     let mut next = predicted.clone();
-    let report = settle(newton, &mut next, settings)?;
+    let report = minimize_to_stable(newton, &mut next, settings)?;
     let miss = next.largest_node_distance(&predicted);
     Ok(Step {
         state: next,
@@ -168,7 +168,7 @@ fn locate_on_path(
     let (mut lo, mut hi) = (from.clone(), to);
     while clamp_gap(&lo.clamps, &hi) > JUMP_LOCATION {
         let mid = midpoint(&lo.clamps, &hi);
-        let trial = carry(newton, &lo, mid, settings)?;
+        let trial = move_clamps(newton, &lo, mid, settings)?;
         if same(newton, &trial)? {
             lo = trial.state;
         } else {
@@ -218,7 +218,7 @@ pub fn run_loading(
     observer: &mut Observer<'_>,
 ) -> Result<Vec<Event>> {
     let mut events = Vec::new();
-    let report = settle(newton, &mut state, settings)?;
+    let report = minimize_to_stable(newton, &mut state, settings)?;
     let mut eq = analyse(newton, &state, &report, measure)?;
     observer(eq.clone())?;
     for (leg, stage) in path.iter().enumerate() {
@@ -239,7 +239,7 @@ pub fn run_loading(
                 phi: c0.phi + f * (target.phi - c0.phi),
             };
             let context = || format!("loading leg {leg}, step {k}");
-            let mut step = carry(newton, &state, c, settings).with_context(context)?;
+            let mut step = move_clamps(newton, &state, c, settings).with_context(context)?;
             let mut next =
                 analyse_from(newton, &step.state, &step.report, measure, Some(&eq), None)?;
             if step.jumped || link_jump(&eq, &next).abs() > JUMP_LINK {
@@ -257,7 +257,7 @@ pub fn run_loading(
                 .with_context(context)?;
                 // the last step from the end of the branch jumps; the rod then
                 // moves on from where it landed to this step's clamps
-                let landed = carry(newton, &lo_state, hi, settings).with_context(context)?;
+                let landed = move_clamps(newton, &lo_state, hi, settings).with_context(context)?;
                 let landed_eq = analyse_from(
                     newton,
                     &landed.state,
@@ -283,7 +283,7 @@ pub fn run_loading(
                             landed.miss, lo_eq.link, landed_eq.link, lo_eq.twist, landed_eq.twist
                         ),
                     ));
-                    step = carry(newton, &landed.state, c, settings).with_context(context)?;
+                    step = move_clamps(newton, &landed.state, c, settings).with_context(context)?;
                     next = analyse_from(
                         newton,
                         &step.state,

@@ -13,7 +13,7 @@ use crate::scene::{MapSpec, Scene, SliceSpec};
 use crate::study::boundary::{GridCheck, Traced};
 use crate::study::branch::{BranchOptions, BranchRun};
 use crate::study::error::{Context, Result, StudyError, describe};
-use crate::study::run::reach;
+use crate::study::run::continue_to;
 use crate::study::start::starting_equilibrium;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -309,7 +309,7 @@ fn compute_line(
         .context("[map] needs a [continuation] in φ")?;
     let (mut newton, state, _) = starting_equilibrium(scene, segments)?;
     let settings = c.settings();
-    let state = reach(&mut newton, state, spec.parameter, value, &settings)?;
+    let state = continue_to(&mut newton, state, spec.parameter, value, &settings)?;
     let options = BranchOptions {
         parameter: c.parameter,
         range: c.range,
@@ -327,7 +327,7 @@ fn compute_line(
         Ok(())
     };
     let mut run = BranchRun::new(&mut newton, options, &mut obs, 0);
-    run.run(state, &[1.0, -1.0])?;
+    run.follow(state, &[1.0, -1.0])?;
     let events = std::mem::take(&mut run.events);
     drop(run);
     Ok((eqs, events))

@@ -15,7 +15,7 @@ use crate::study::start::starting_equilibrium;
 /// Move an equilibrium to `parameter = target` by continuation in that
 /// parameter (through folds if need be), ending with a Newton solve at exactly
 /// the target.
-pub fn reach(
+pub fn continue_to(
     newton: &mut Minimizer,
     state: RodState,
     parameter: Parameter,
@@ -122,11 +122,11 @@ pub fn run_scene(
     let mut first_branch = 0;
     for stop in stops {
         if let Some((parameter, value)) = stop {
-            state = reach(&mut newton, state, parameter, value, &settings)
+            state = continue_to(&mut newton, state, parameter, value, &settings)
                 .with_context(|| format!("reaching {} = {value}", parameter.name()))?;
         }
         let mut run = BranchRun::new(&mut newton, options.clone(), &mut *observer, first_branch);
-        run.run(state.clone(), directions)?;
+        run.follow(state.clone(), directions)?;
         first_branch = run.next_branch();
         events.extend(run.events);
     }

@@ -2,7 +2,7 @@
 //! double ring, trefoil, or a restart state) relaxed by the minimiser.
 
 use crate::analysis::class::is_trefoil;
-use crate::analysis::equilibrium::{Equilibrium, Shape, analyse};
+use crate::analysis::equilibrium::{Conformation, Equilibrium, analyse};
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
@@ -67,7 +67,7 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
                 state.reference_twist[n] = rt + 2.0 * std::f64::consts::PI * turns;
             };
             set(&mut state, 0.0);
-            let shape = Shape::of(&state, &scene.measure());
+            let shape = Conformation::of(&state, &scene.measure());
             if !is_trefoil(shape.knot.determinant) {
                 fail!(
                     "initial.shape = \"trefoil\": at z* = {}, δ = {} the guide curve's ray \
@@ -154,7 +154,7 @@ pub fn starting_equilibrium(
                 delta: f * target.delta,
                 phi: ring.phi + f * (target.phi - ring.phi),
             };
-            let step = crate::study::loading::carry(&mut newton, &state, c, &scene.solver)
+            let step = crate::study::loading::move_clamps(&mut newton, &state, c, &scene.solver)
                 .with_context(|| format!("unfolding the double ring, step {k} of {steps}"))?;
             (state, report) = (step.state, step.report);
         }

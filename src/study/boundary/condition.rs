@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 
 /// The other strand of a crossing.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Other {
+pub enum OtherStrand {
     /// Another segment of the centreline.
     Segment(usize),
     /// The ray continuing the s = 0 clamp (along −e3).
@@ -21,7 +21,7 @@ pub struct Strands {
     /// Segment of the centreline (segment k joins centreline points k, k+1).
     pub first: usize,
     /// The strand it crosses.
-    pub other: Other,
+    pub other: OtherStrand,
     /// Orientation: +1 or −1, so that the good side is positive.
     pub sign: f64,
     /// Number of centreline segments (for the flip image of the strands).
@@ -71,9 +71,9 @@ impl Condition {
         match self {
             Condition::Wall => "wall".into(),
             Condition::Crossing(s) => match s.other {
-                Other::Segment(j) => format!("crossing of segments {} and {j}", s.first),
-                Other::BottomRay => format!("segment {} crossing the bottom ray", s.first),
-                Other::TopRay => format!("segment {} crossing the top ray", s.first),
+                OtherStrand::Segment(j) => format!("crossing of segments {} and {j}", s.first),
+                OtherStrand::BottomRay => format!("segment {} crossing the bottom ray", s.first),
+                OtherStrand::TopRay => format!("segment {} crossing the top ray", s.first),
             },
             Condition::Stability => "lowest eigenvalue zero".into(),
         }
@@ -85,15 +85,15 @@ impl Condition {
 pub(super) fn strand_distance(
     points: &[Vector3<f64>],
     i: usize,
-    other: Other,
+    other: OtherStrand,
     reach: f64,
 ) -> (f64, f64) {
     let (a0, a1) = (points[i], points[i + 1]);
     let last = *points.last().unwrap();
     let (b0, b1) = match other {
-        Other::Segment(j) => (points[j], points[j + 1]),
-        Other::BottomRay => (points[0], points[0] - reach * Vector3::z()),
-        Other::TopRay => (last, last + reach * Vector3::z()),
+        OtherStrand::Segment(j) => (points[j], points[j + 1]),
+        OtherStrand::BottomRay => (points[0], points[0] - reach * Vector3::z()),
+        OtherStrand::TopRay => (last, last + reach * Vector3::z()),
     };
     let (d, ta, tb) = segment_distance(&a0, &a1, &b0, &b1);
     let pa = a0 + ta * (a1 - a0);
@@ -107,21 +107,21 @@ impl Strands {
     /// the flip symmetry (s ↔ 1 − s, the rays swapped): a flip-symmetric
     /// knot passes through itself at two mirror points at once, so the two
     /// crossings are one boundary.
-    pub(super) fn near(&self, first: usize, other: Other) -> bool {
+    pub(super) fn near(&self, first: usize, other: OtherStrand) -> bool {
         // strands crossing at a shallow angle are close over several pairs
         let close = |x: usize, y: usize| x.abs_diff(y) <= 3;
-        let same = |a: usize, oa: Other, b: usize, ob: Other| {
+        let same = |a: usize, oa: OtherStrand, b: usize, ob: OtherStrand| {
             close(a, b)
                 && match (oa, ob) {
-                    (Other::Segment(i), Other::Segment(j)) => close(i, j),
+                    (OtherStrand::Segment(i), OtherStrand::Segment(j)) => close(i, j),
                     (x, y) => x == y,
                 }
         };
         let m = |i: usize| (self.segments - 1).saturating_sub(i);
         let mirror = match other {
-            Other::Segment(j) => (m(j), Other::Segment(m(first))),
-            Other::BottomRay => (m(first), Other::TopRay),
-            Other::TopRay => (m(first), Other::BottomRay),
+            OtherStrand::Segment(j) => (m(j), OtherStrand::Segment(m(first))),
+            OtherStrand::BottomRay => (m(first), OtherStrand::TopRay),
+            OtherStrand::TopRay => (m(first), OtherStrand::BottomRay),
         };
         same(self.first, self.other, first, other)
             || same(self.first, self.other, mirror.0, mirror.1)
@@ -138,21 +138,21 @@ pub(super) fn closest_strands(
     arc: &[f64],
     gap: f64,
     except: &[Strands],
-) -> (usize, Other) {
+) -> (usize, OtherStrand) {
     let reach = crate::geometry::closure::reach(points);
     let segments = points.len() - 1;
-    let skip = |i: usize, o: Other| except.iter().any(|e| e.near(i, o));
-    let mut best = (f64::INFINITY, 0, Other::TopRay);
+    let skip = |i: usize, o: OtherStrand| except.iter().any(|e| e.near(i, o));
+    let mut best = (f64::INFINITY, 0, OtherStrand::TopRay);
     for i in 0..segments {
         for j in i + 1..segments {
-            if arc[j] - arc[i + 1] >= gap && !skip(i, Other::Segment(j)) {
-                let d = strand_distance(points, i, Other::Segment(j), reach).0;
+            if arc[j] - arc[i + 1] >= gap && !skip(i, OtherStrand::Segment(j)) {
+                let d = strand_distance(points, i, OtherStrand::Segment(j), reach).0;
                 if d < best.0 {
-                    best = (d, i, Other::Segment(j));
+                    best = (d, i, OtherStrand::Segment(j));
                 }
             }
         }
-        for (ray, base) in [(Other::BottomRay, 0.0), (Other::TopRay, 1.0)] {
+        for (ray, base) in [(OtherStrand::BottomRay, 0.0), (OtherStrand::TopRay, 1.0)] {
             let mid = 0.5 * (arc[i] + arc[i + 1]);
             if (mid - base).abs() >= gap && !skip(i, ray) {
                 let d = strand_distance(points, i, ray, reach).0;
@@ -180,8 +180,8 @@ mod tests {
                 Vector3::new(0.0, 1.0, h),
             ]
         };
-        let (d, up) = strand_distance(&at(0.3), 0, Other::Segment(2), 10.0);
-        let (_, down) = strand_distance(&at(-0.2), 0, Other::Segment(2), 10.0);
+        let (d, up) = strand_distance(&at(0.3), 0, OtherStrand::Segment(2), 10.0);
+        let (_, down) = strand_distance(&at(-0.2), 0, OtherStrand::Segment(2), 10.0);
         assert!((d - 0.3).abs() < 1e-12 && (up - 0.3).abs() < 1e-12);
         assert!((down + 0.2).abs() < 1e-12);
     }
@@ -190,21 +190,21 @@ mod tests {
     fn strands_are_the_same_up_to_neighbours_and_the_flip_image() {
         let s = Strands {
             first: 22,
-            other: Other::Segment(76),
+            other: OtherStrand::Segment(76),
             sign: 1.0,
             segments: 101,
         };
-        assert!(s.near(24, Other::Segment(74)));
+        assert!(s.near(24, OtherStrand::Segment(74)));
         // the flip image s ↔ 1 − s: segment i ↔ 100 − i, the pair reversed
-        assert!(s.near(24, Other::Segment(78)));
-        assert!(!s.near(12, Other::Segment(89)));
+        assert!(s.near(24, OtherStrand::Segment(78)));
+        assert!(!s.near(12, OtherStrand::Segment(89)));
         let r = Strands {
             first: 10,
-            other: Other::BottomRay,
+            other: OtherStrand::BottomRay,
             sign: 1.0,
             segments: 101,
         };
-        assert!(r.near(90, Other::TopRay));
-        assert!(!r.near(90, Other::BottomRay));
+        assert!(r.near(90, OtherStrand::TopRay));
+        assert!(!r.near(90, OtherStrand::BottomRay));
     }
 }

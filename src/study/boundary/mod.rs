@@ -24,6 +24,6 @@ mod condition;
 mod traced;
 mod walk;
 
-pub use condition::{Condition, Other, Strands};
+pub use condition::{Condition, OtherStrand, Strands};
 pub use traced::{GridCheck, Piece, Traced};
 pub use walk::trace_island;

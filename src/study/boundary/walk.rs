@@ -9,8 +9,9 @@ use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::MapSpec;
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
+use crate::solve::step::StepControl;
 use crate::study::boundary::condition::{
-    Condition, Failure, Other, Strands, closest_strands, strand_distance,
+    Condition, Failure, OtherStrand, Strands, closest_strands, strand_distance,
 };
 use crate::study::boundary::traced::{Traced, Trail, name_pieces};
 use crate::study::error::{Context, Result, describe, fail};
@@ -83,12 +84,12 @@ impl Walk<'_, '_> {
 
     /// The equilibrium at `p`, continued from the one at `from` in moves of at
     /// most `SUBSTEP` per coordinate.
-    fn settle(&mut self, from: &Site, p: [f64; 2]) -> Result<Site> {
-        self.settle_from(&from.point.state, from.p, p)
+    fn equilibrium_at(&mut self, from: &Site, p: [f64; 2]) -> Result<Site> {
+        self.equilibrium_from(&from.point.state, from.p, p)
     }
 
     /// The equilibrium at `p`, continued from the equilibrium `state` at `from`.
-    fn settle_from(&mut self, state: &RodState, from: [f64; 2], p: [f64; 2]) -> Result<Site> {
+    fn equilibrium_from(&mut self, state: &RodState, from: [f64; 2], p: [f64; 2]) -> Result<Site> {
         if !(p[0].is_finite() && p[1].is_finite()) {
             fail!("boundary walk: non-finite parameters");
         }
@@ -139,10 +140,10 @@ impl Walk<'_, '_> {
                 let near = |k: usize| k.saturating_sub(3)..(k + 4).min(segments);
                 let mut best = (f64::INFINITY, 0.0, s.first, s.other);
                 for i in near(s.first) {
-                    let others: Vec<Other> = match s.other {
-                        Other::Segment(j) => near(j)
+                    let others: Vec<OtherStrand> = match s.other {
+                        OtherStrand::Segment(j) => near(j)
                             .filter(|&j| j >= i + 2)
-                            .map(Other::Segment)
+                            .map(OtherStrand::Segment)
                             .collect(),
                         ray => vec![ray],
                     };
@@ -190,7 +191,7 @@ impl Walk<'_, '_> {
         for (k, gk) in g.iter_mut().enumerate() {
             let mut p = site.p;
             p[k] += h;
-            let s = self.settle(site, p)?;
+            let s = self.equilibrium_at(site, p)?;
             *gk = (self.value(c, &s)? - g0) / h;
         }
         if !(g[0].is_finite() && g[1].is_finite()) || g == [0.0, 0.0] {
@@ -222,7 +223,7 @@ impl Walk<'_, '_> {
         }
         let trefoil = |s: &RodState| is_trefoil(closure_knot(&s.centreline().0).determinant);
         let knotted = if skip == Some(Failure::Knot) {
-            let off = self.settle(site, along(site.p, normal, FD))?;
+            let off = self.equilibrium_at(site, along(site.p, normal, FD))?;
             trefoil(&off.point.state)
         } else {
             trefoil(state)
@@ -283,7 +284,7 @@ impl Walk<'_, '_> {
         } else {
             0.0
         };
-        let mut site = self.settle(from, p)?;
+        let mut site = self.equilibrium_at(from, p)?;
         let mut g = self.value(c, &site)?;
         let (mut s, mut slope, mut last_root) = (0.0, slope, f64::NAN);
         for it in 1..=12 {
@@ -298,7 +299,7 @@ impl Walk<'_, '_> {
                 return Ok((site, it));
             }
             let target = root + offset;
-            let next = self.settle(&site, along(p, normal, target))?;
+            let next = self.equilibrium_at(&site, along(p, normal, target))?;
             let gn = self.value(c, &next)?;
             // secant update, unless the points are too close for the lowest
             // eigenvalue's accuracy (then the chord's slope is kept)
@@ -383,12 +384,12 @@ pub fn trace_island(
         );
     }
     let start = walk
-        .settle_from(&state, p0, p0)
+        .equilibrium_from(&state, p0, p0)
         .context("the map's start")?;
     let (start, p0) = match spec.trace_from {
         Some(p) if p != p0 => {
             let s = walk
-                .settle(&start, p)
+                .equilibrium_at(&start, p)
                 .context("from the scene's start to map.trace_from")?;
             (s, p)
         }
@@ -416,14 +417,69 @@ pub fn trace_island(
     ))
 }
 
-/// Move up in φ from `start` to the first boundary, then walk around.
+/// Walk round the good region from `start`: up in φ to the first boundary,
+/// then along each condition, turning at every corner, until the walk
+/// passes its start again.
 fn walk_around(
     walk: &mut Walk,
     start: Site,
     pieces: &mut Vec<Trail>,
     on_point: &dyn Fn(usize, &str),
 ) -> Result<()> {
-    // first boundary above the start in φ
+    let (c, at) = first_boundary(walk, start)?;
+    let mut tour = Tour {
+        first: at.site.on,
+        first_kind: c.failure(),
+        c,
+        at,
+        step: StepControl::new(FIRST_STEP, MIN_STEP, walk.max_step, 1.4, 4),
+        count: 1,
+        stuck: 0,
+        tried: Vec::new(),
+    };
+    pieces.push((tour.c, vec![(tour.first, unit(tour.at.gradient)[1])]));
+    loop {
+        tour.check_budget(walk)?;
+        let t = left_tangent(tour.at.gradient);
+        let normal = unit(tour.at.gradient);
+        let Some((q, iterations, g)) = tour.advance(walk, t)? else {
+            continue;
+        };
+        if !walk.inside(q.p) {
+            fail!(
+                "the good region reaches the map's range at ({:.5}, {:.5})",
+                q.p[0],
+                q.p[1]
+            );
+        }
+        match walk.failing(&q, Some(&tour.c), unit(g))? {
+            None => {
+                if tour.closes(&q, t) {
+                    let side = pieces[0].1[0].1;
+                    pieces.last_mut().unwrap().1.push((tour.first, side));
+                    return Ok(());
+                }
+                let piece = pieces.last_mut().unwrap();
+                piece.1.push((q.on, unit(g)[1]));
+                tour.count += 1;
+                on_point(tour.count, &piece.0.describe());
+                tour.at = Step {
+                    site: q,
+                    gradient: g,
+                };
+                tour.step.accepted(iterations);
+            }
+            Some(failure) => {
+                tour.turn_at_corner(walk, q, failure, normal, pieces)?;
+                on_point(tour.count, &tour.c.describe());
+            }
+        }
+    }
+}
+
+/// The first boundary above the start in φ (bisected to it), its condition
+/// oriented positive on the good side, and the walk's first point on it.
+fn first_boundary(walk: &mut Walk, start: Site) -> Result<(Condition, Step)> {
     let up = [0.0, 1.0];
     let mut good = start;
     let bad = loop {
@@ -431,7 +487,7 @@ fn walk_around(
         if !walk.inside(p) {
             fail!("no boundary above the start within the map's φ range");
         }
-        let s = walk.settle(&good, p)?;
+        let s = walk.equilibrium_at(&good, p)?;
         match walk.failing(&s, None, up)? {
             None => good = s,
             Some(f) => break (s, f),
@@ -445,7 +501,7 @@ fn walk_around(
         1e-9
     };
     while hi.p[1] - lo.p[1] > tol {
-        let mid = walk.settle(&lo, [lo.p[0], 0.5 * (lo.p[1] + hi.p[1])])?;
+        let mid = walk.equilibrium_at(&lo, [lo.p[0], 0.5 * (lo.p[1] + hi.p[1])])?;
         match walk.failing(&mid, None, up)? {
             None => lo = mid,
             Some(_) => hi = mid,
@@ -454,158 +510,188 @@ fn walk_around(
     let mut c = walk.condition_of(failure, &hi, &[]);
     walk.orient_at(&mut c, &reference)?;
     let gradient = walk.gradient(&mut c, &lo)?;
-    let (first, first_kind) = (lo.on, c.failure());
-    let mut at = Step { site: lo, gradient };
-    pieces.push((c, vec![(first, unit(at.gradient)[1])]));
-    let mut sigma = FIRST_STEP;
-    let mut count = 1;
-    let mut stuck = 0;
-    let mut tried: Vec<Strands> = Vec::new();
-    loop {
-        if count >= MAX_POINTS || walk.equilibria >= MAX_EQUILIBRIA {
+    Ok((c, Step { site: lo, gradient }))
+}
+
+/// The walk's progress round the region.
+struct Tour {
+    /// The condition followed now.
+    c: Condition,
+    /// The last point on it.
+    at: Step,
+    /// Step along the curve.
+    step: StepControl,
+    /// Points so far.
+    count: usize,
+    /// Corners met in a row without progress.
+    stuck: usize,
+    /// Crossings tried at this corner.
+    tried: Vec<Strands>,
+    /// Where the walk started, and on which kind of condition.
+    first: [f64; 2],
+    first_kind: Failure,
+}
+
+impl Tour {
+    /// Stop a walk that creeps through a tangle of tiny corners.
+    fn check_budget(&self, walk: &Walk) -> Result<()> {
+        if self.count >= MAX_POINTS || walk.equilibria >= MAX_EQUILIBRIA {
             fail!(
-                "boundary walk: {count} points and {} equilibria without closing, at ({:.5}, {:.5})",
+                "boundary walk: {} points and {} equilibria without closing, at ({:.5}, {:.5})",
+                self.count,
                 walk.equilibria,
-                at.site.on[0],
-                at.site.on[1]
+                self.at.site.on[0],
+                self.at.site.on[1]
             );
         }
-        let t = left_tangent(at.gradient);
-        let normal = unit(at.gradient);
+        Ok(())
+    }
+
+    /// The next point one step along the tangent `t`, corrected onto the
+    /// curve, with its corrector iterations and gradient; None when the step
+    /// was halved (the corrector failed or the curve turned too sharply).
+    fn advance(&mut self, walk: &mut Walk, t: [f64; 2]) -> Result<Option<(Site, usize, [f64; 2])>> {
+        let sigma = self.step.length;
+        let c = &mut self.c;
         let attempt = walk
-            .correct_along(&mut c, &at, sigma, sigma)
+            .correct_along(c, &self.at, sigma, sigma)
             .and_then(|(q, it)| {
-                let g = walk.gradient(&mut c, &q)?;
+                let g = walk.gradient(c, &q)?;
                 Ok((q, it, g))
             });
-        let (q, iterations, g) = match attempt {
-            Ok((q, it, g)) if sigma < 1e-4 || dot2(left_tangent(g), t) > 0.97 => (q, it, g),
+        match attempt {
+            Ok((q, it, g)) if sigma < 1e-4 || dot2(left_tangent(g), t) > 0.97 => {
+                Ok(Some((q, it, g)))
+            }
             other => {
-                sigma *= 0.5;
-                if sigma < MIN_STEP {
+                if !self.step.shrink() {
                     let why = other
                         .err()
                         .map_or("the boundary turns too sharply".into(), |e| describe(&e));
                     fail!(
                         "boundary walk stopped on {} at ({:.5}, {:.5}): {why}",
-                        c.describe(),
-                        at.site.p[0],
-                        at.site.p[1]
+                        self.c.describe(),
+                        self.at.site.p[0],
+                        self.at.site.p[1]
                     );
                 }
-                continue;
+                Ok(None)
             }
-        };
-        if !walk.inside(q.p) {
+        }
+    }
+
+    /// The walk closed: its start lies between the last point and `q`, on
+    /// the same kind of condition.
+    fn closes(&self, q: &Site, t: [f64; 2]) -> bool {
+        let first = self.first;
+        let d0 = [first[0] - self.at.site.on[0], first[1] - self.at.site.on[1]];
+        let d1 = [first[0] - q.on[0], first[1] - q.on[1]];
+        let near = d0[0].hypot(d0[1]) < 2.0 * self.step.length;
+        self.count > 3
+            && self.c.failure() == self.first_kind
+            && near
+            && dot2(d0, t) > 0.0
+            && dot2(d1, t) <= 0.0
+    }
+
+    /// A corner: bisect along the curve to where another property fails
+    /// (first seen failing at `q`), and turn onto that property's condition.
+    fn turn_at_corner(
+        &mut self,
+        walk: &mut Walk,
+        q: Site,
+        first_failure: Failure,
+        normal: [f64; 2],
+        pieces: &mut Vec<Trail>,
+    ) -> Result<()> {
+        let sigma = self.step.length;
+        let (good, bad, failure, progress) =
+            self.bisect_corner(walk, q, first_failure, normal, sigma)?;
+        // a corner right at the previous one: the crossing taken there made
+        // no progress (several strands in contact at a tip), so the next
+        // closest strands are tried
+        if progress < 1e-6 {
+            self.stuck += 1;
+        } else {
+            self.stuck = 0;
+            self.tried.clear();
+        }
+        if let Condition::Crossing(s) = self.c {
+            self.tried.push(s);
+        }
+        if self.stuck > 12 {
             fail!(
-                "the good region reaches the map's range at ({:.5}, {:.5})",
-                q.p[0],
-                q.p[1]
+                "boundary walk stuck at a corner of {} at ({:.5}, {:.5})",
+                self.c.describe(),
+                good.on[0],
+                good.on[1]
             );
         }
-        match walk.failing(&q, Some(&c), unit(g))? {
-            None => {
-                // closed: the start lies between this point and the last
-                let d0 = [first[0] - at.site.on[0], first[1] - at.site.on[1]];
-                let d1 = [first[0] - q.on[0], first[1] - q.on[1]];
-                let near = d0[0].hypot(d0[1]) < 2.0 * sigma;
-                if count > 3
-                    && c.failure() == first_kind
-                    && near
-                    && dot2(d0, t) > 0.0
-                    && dot2(d1, t) <= 0.0
-                {
-                    let side = pieces[0].1[0].1;
-                    pieces.last_mut().unwrap().1.push((first, side));
-                    return Ok(());
+        let corner = good.on;
+        let old = unit(walk.gradient(&mut self.c, &good)?)[1];
+        pieces.last_mut().unwrap().1.push((corner, old));
+        let mut c = walk.condition_of(failure, &bad, &self.tried);
+        walk.orient_at(&mut c, &self.at.site)?;
+        let mut gradient = walk.gradient(&mut c, &good)?;
+        // the region is the intersection of the good sides, so the walk
+        // leaves a corner into the old condition's good side; a crossing
+        // whose sign at the last point says otherwise is turned round
+        if let Condition::Crossing(s) = &mut c
+            && dot2(left_tangent(gradient), normal) < 0.0
+        {
+            s.sign = -s.sign;
+            gradient = [-gradient[0], -gradient[1]];
+        }
+        pieces.push((c, vec![(corner, unit(gradient)[1])]));
+        self.count += 1;
+        self.c = c;
+        self.at = Step {
+            site: good,
+            gradient,
+        };
+        self.step.restart();
+        Ok(())
+    }
+
+    /// Bisect the step `sigma` along the curve between the last good point
+    /// and `q`: the last good site, the first failing one, what fails there,
+    /// and how far along the corner lies.
+    fn bisect_corner(
+        &mut self,
+        walk: &mut Walk,
+        q: Site,
+        first_failure: Failure,
+        normal: [f64; 2],
+        sigma: f64,
+    ) -> Result<(Site, Site, Failure, f64)> {
+        let (mut a, mut b) = (0.0, sigma);
+        let mut good = self.at.site.clone();
+        let (mut bad, mut failure) = (q, first_failure);
+        let tol = if first_failure == Failure::Stability {
+            STABILITY_TOL
+        } else {
+            1e-8
+        };
+        while b - a > tol {
+            let m = 0.5 * (a + b);
+            // no equilibrium on the curve there: count it as past the corner
+            let Ok((s, _)) = walk.correct_along(&mut self.c, &self.at, m, sigma) else {
+                b = m;
+                continue;
+            };
+            match walk.failing(&s, Some(&self.c), normal)? {
+                None => {
+                    a = m;
+                    good = s;
                 }
-                let piece = pieces.last_mut().unwrap();
-                piece.1.push((q.on, unit(g)[1]));
-                count += 1;
-                on_point(count, &piece.0.describe());
-                at = Step {
-                    site: q,
-                    gradient: g,
-                };
-                if iterations <= 4 {
-                    sigma = (1.4 * sigma).min(walk.max_step);
+                Some(f) => {
+                    b = m;
+                    failure = f;
+                    bad = s;
                 }
-            }
-            Some(first_failure) => {
-                // a corner: bisect along the curve to where another property fails
-                let (mut a, mut b) = (0.0, sigma);
-                let mut good = at.site.clone();
-                let (mut bad, mut failure) = (q, first_failure);
-                let tol = if first_failure == Failure::Stability {
-                    STABILITY_TOL
-                } else {
-                    1e-8
-                };
-                while b - a > tol {
-                    let m = 0.5 * (a + b);
-                    // no equilibrium on the curve there: count it as past the corner
-                    let Ok((s, _)) = walk.correct_along(&mut c, &at, m, sigma) else {
-                        b = m;
-                        continue;
-                    };
-                    match walk.failing(&s, Some(&c), normal)? {
-                        None => {
-                            a = m;
-                            good = s;
-                        }
-                        Some(f) => {
-                            b = m;
-                            failure = f;
-                            bad = s;
-                        }
-                    }
-                }
-                // a corner right at the previous one: the crossing taken there
-                // made no progress (several strands in contact at a tip), so
-                // the next closest strands are tried
-                if b < 1e-6 {
-                    stuck += 1;
-                } else {
-                    stuck = 0;
-                    tried.clear();
-                }
-                if let Condition::Crossing(s) = c {
-                    tried.push(s);
-                }
-                if stuck > 12 {
-                    fail!(
-                        "boundary walk stuck at a corner of {} at ({:.5}, {:.5})",
-                        c.describe(),
-                        good.on[0],
-                        good.on[1]
-                    );
-                }
-                let corner = good.on;
-                let old = unit(walk.gradient(&mut c, &good)?)[1];
-                pieces.last_mut().unwrap().1.push((corner, old));
-                c = walk.condition_of(failure, &bad, &tried);
-                walk.orient_at(&mut c, &at.site)?;
-                let mut gradient = walk.gradient(&mut c, &good)?;
-                // the region is the intersection of the good sides, so the
-                // walk leaves a corner into the old condition's good side; a
-                // crossing whose sign at the last point says otherwise is
-                // turned round
-                if let Condition::Crossing(s) = &mut c
-                    && dot2(left_tangent(gradient), normal) < 0.0
-                {
-                    s.sign = -s.sign;
-                    gradient = [-gradient[0], -gradient[1]];
-                }
-                pieces.push((c, vec![(corner, unit(gradient)[1])]));
-                count += 1;
-                on_point(count, &c.describe());
-                at = Step {
-                    site: good,
-                    gradient,
-                };
-                sigma = FIRST_STEP;
             }
         }
+        Ok((good, bad, failure, b))
     }
 }
 
