@@ -4,8 +4,10 @@
 use knotrod::analysis::equilibrium::Equilibrium;
 use knotrod::analysis::event::{Event, EventKind};
 use knotrod::scene::Scene;
-use knotrod::study::run::run_scene;
 use knotrod::study::start::solve_scene;
+
+mod common;
+use common::run;
 
 /// A straight clamped-clamped rod (z* = 1) whose midpoint is pushed sideways
 /// by `deflection` by a segment obstacle across it.
@@ -51,12 +53,7 @@ fn clamped_beam_on_a_point_obstacle_has_the_beam_theory_force() {
 #[test]
 fn trefoil_on_the_rays_a_to_b_to_c() {
     let scene = Scene::load(std::path::Path::new("scenes/trefoil_contact_start.toml")).unwrap();
-    let mut eqs: Vec<Equilibrium> = Vec::new();
-    let events: Vec<Event> = run_scene(&scene, None, &mut |e| {
-        eqs.push(e);
-        Ok(())
-    })
-    .unwrap();
+    let (eqs, events) = run(&scene);
     let h = scene.model.rod_diameter;
     // nothing ever passes through anything: knot and link's integer part kept
     for e in &eqs {
@@ -151,12 +148,7 @@ fn twisted_loop_closes_on_itself_without_passing_through() {
          [stability]\neigenvalues = 1\n"
     ))
     .unwrap();
-    let mut eqs: Vec<Equilibrium> = Vec::new();
-    run_scene(&scene, None, &mut |e| {
-        eqs.push(e);
-        Ok(())
-    })
-    .unwrap();
+    let (eqs, _) = run(&scene);
     assert!((eqs.last().unwrap().phi_over_2pi - 2.5).abs() < 1e-9);
     let mut first_contact = None;
     let mut last_force = 0.0;

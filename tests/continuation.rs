@@ -4,17 +4,9 @@
 use knotrod::analysis::equilibrium::Equilibrium;
 use knotrod::analysis::event::{Event, EventKind};
 use knotrod::scene::Scene;
-use knotrod::study::run::run_scene;
 
-fn run(scene: &Scene) -> (Vec<Equilibrium>, Vec<Event>) {
-    let mut eqs = Vec::new();
-    let events = run_scene(scene, None, &mut |e| {
-        eqs.push(e);
-        Ok(())
-    })
-    .unwrap();
-    (eqs, events)
-}
+mod common;
+use common::run;
 
 /// Every state of a loading path a converged minimum; its jumps.
 fn converged_minima_and_jumps<'a>(eqs: &[Equilibrium], events: &'a [Event]) -> Vec<&'a Event> {
@@ -33,9 +25,7 @@ fn converged_minima_and_jumps<'a>(eqs: &[Equilibrium], events: &'a [Event]) -> V
 
 /// A paper scene at another N with extra TOML appended.
 fn paper_scene(file: &str, segments: usize, extra: &str) -> Scene {
-    let text = std::fs::read_to_string(file).unwrap();
-    let text = text.replace("segments = 200", &format!("segments = {segments}"));
-    let text = text.split("[output]").next().unwrap().to_string();
+    let text = common::scene_text_at(file, segments);
     let text = text.split("[continuation]").next().unwrap().to_string();
     let mut scene = Scene::parse(&format!("{text}\n{extra}")).unwrap();
     scene.name = Some(file.into());

@@ -86,19 +86,11 @@ fn writhe_carried_along_a_branch_equals_the_full_writhe() {
     // over from the previous one (Lk = n + φ/2π) unless a strand came near
     // another; recompute each from scratch and compare
     use knotrod::analysis::equilibrium::Conformation;
-    let text = std::fs::read_to_string("scenes/fig3_kirchhoff.toml").unwrap();
-    let text = text.replace("segments = 200", "segments = 100");
-    let text = text.split("[output]").next().unwrap();
-    let mut scene = knotrod::scene::Scene::parse(text).unwrap();
+    let mut scene = common::scene_at("scenes/fig3_kirchhoff.toml", 100);
     if let Some(c) = scene.continuation.as_mut() {
         c.switch_branches = false;
     }
-    let mut eqs = Vec::new();
-    knotrod::study::run::run_scene(&scene, None, &mut |e| {
-        eqs.push(e);
-        Ok(())
-    })
-    .unwrap();
+    let (eqs, _) = common::run(&scene);
     assert!(eqs.len() > 50);
     let measure = scene.measure();
     let mut largest = 0.0f64;

@@ -2,14 +2,9 @@
 //! resuming from computed lines, and the island's boundaries.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn knotrod(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_knotrod"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+mod common;
+use common::{knotrod, knotrod_ok, temp_dir};
 
 /// The Figure 7-left scene with some settings replaced, written into `dir`.
 fn fig7_variant(dir: &Path, name: &str, replace: &[(&str, &str)]) -> PathBuf {
@@ -21,16 +16,6 @@ fn fig7_variant(dir: &Path, name: &str, replace: &[(&str, &str)]) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
     p
-}
-
-/// Run knotrod and require success.
-fn knotrod_ok(args: &[&str]) {
-    let out = knotrod(args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
 }
 
 fn small_map_scene(dir: &Path) -> PathBuf {
@@ -49,8 +34,7 @@ fn small_map_scene(dir: &Path) -> PathBuf {
 
 #[test]
 fn shards_merge_to_the_single_run_bit_for_bit_and_maps_resume() {
-    let dir = std::env::temp_dir().join(format!("knotrod-map-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("map");
     let scene = small_map_scene(&dir);
     let s = scene.to_str().unwrap();
     let whole = dir.join("whole.json");
@@ -116,8 +100,7 @@ fn shards_merge_to_the_single_run_bit_for_bit_and_maps_resume() {
 /// interval end the loop spans.
 #[test]
 fn island_boundary_traced_directly_agrees_with_the_grid() {
-    let dir = std::env::temp_dir().join(format!("knotrod-trace-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("trace");
     let scene = fig7_variant(
         &dir,
         "trace.toml",

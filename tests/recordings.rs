@@ -8,18 +8,8 @@ use knotrod::io::recording::{
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn knotrod(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_knotrod"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("knotrod-rec-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+mod common;
+use common::{knotrod, temp_dir};
 
 /// Run a scene recording to `rec`; the recording's bytes.
 fn run_recorded(scene: &Path, rec: &Path) -> Vec<u8> {
@@ -54,7 +44,7 @@ fn short_branch_scene(dir: &Path, extra: &str) -> PathBuf {
 
 #[test]
 fn recording_has_foxglove_schemas_and_every_message_decodes() {
-    let dir = temp("schemas");
+    let dir = temp_dir("rec-schemas");
     let scene = short_branch_scene(&dir, "");
     let rec = dir.join("run.mcap");
     let bytes = run_recorded(&scene, &rec);
@@ -134,7 +124,7 @@ fn recording_has_foxglove_schemas_and_every_message_decodes() {
 
 #[test]
 fn a_recorded_state_restarts_the_run_exactly() {
-    let dir = temp("restart");
+    let dir = temp_dir("rec-restart");
     let scene = short_branch_scene(&dir, "");
     let rec = dir.join("run.mcap");
     let json = dir.join("run.json");
@@ -205,7 +195,7 @@ fn a_recorded_state_restarts_the_run_exactly() {
 
 #[test]
 fn interrupted_run_leaves_a_finalised_recording() {
-    let dir = temp("interrupt");
+    let dir = temp_dir("rec-interrupt");
     // a long branch so that it is still running when interrupted
     let scene = short_branch_scene(&dir, "").to_str().unwrap().to_string();
     let text = std::fs::read_to_string(&scene)
@@ -266,7 +256,7 @@ fn interrupted_run_leaves_a_finalised_recording() {
 
 #[test]
 fn damaged_recordings_give_clear_errors() {
-    let dir = temp("damaged");
+    let dir = temp_dir("rec-damaged");
     let scene = short_branch_scene(&dir, "");
     let rec = dir.join("run.mcap");
     assert!(
@@ -301,7 +291,7 @@ fn damaged_recordings_give_clear_errors() {
 fn contacts_are_recorded_and_drawn() {
     // a clamped beam pushed by a segment obstacle: one contact, drawn as a
     // red cube at the contact point, its force in the scalars
-    let dir = temp("contacts");
+    let dir = temp_dir("rec-contacts");
     let scene = dir.join("beam.toml");
     std::fs::write(
         &scene,

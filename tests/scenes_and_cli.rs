@@ -1,7 +1,9 @@
 //! Scene validation (errors name the field, never a panic) and the command line.
 
 use knotrod::scene::{Scene, SceneError};
-use std::process::Command;
+
+mod common;
+use common::{knotrod, temp_dir};
 
 const GOOD: &str = r#"
 [model]
@@ -89,17 +91,9 @@ fn bad_scenes_name_the_field() {
     ));
 }
 
-fn knotrod(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_knotrod"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
 #[test]
 fn run_writes_summary_and_restarts_from_it() {
-    let dir = std::env::temp_dir().join(format!("knotrod-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("cli");
     let first = dir.join("first.json");
     let out = knotrod(&[
         "run",
@@ -181,8 +175,7 @@ fn run_writes_summary_and_restarts_from_it() {
 
 #[test]
 fn bad_input_is_a_clear_error_not_a_panic() {
-    let dir = std::env::temp_dir().join(format!("knotrod-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("bad");
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, GOOD.replace("segments = 40", "segments = -5")).unwrap();
     let out = knotrod(&["run", bad.to_str().unwrap()]);
@@ -219,8 +212,7 @@ fn write_curve(path: &std::path::Path, sep: &str, f: impl Fn(f64) -> [f64; 3], m
 
 #[test]
 fn knot_command_names_small_knots() {
-    let dir = std::env::temp_dir().join(format!("knotrod-knot-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("knot");
     let torus = |p: f64, q: f64| {
         move |t: f64| {
             [

@@ -3,8 +3,7 @@
 //! on the constraint tangent space; the double ring's stability criterion
 //! (paper eq. 2.7); Figure 8.
 
-use knotrod::analysis::equilibrium::Equilibrium;
-use knotrod::analysis::event::{Event, EventKind};
+use knotrod::analysis::event::EventKind;
 use knotrod::linalg::eigen::lowest_eigenvalues;
 use knotrod::linalg::sparse::Ldlt;
 use knotrod::model::energy::RodEnergy;
@@ -12,9 +11,11 @@ use knotrod::model::rod::{Law, RodModel, RodState};
 use knotrod::scene::Scene;
 use knotrod::solve::minimizer::Minimizer;
 use knotrod::solve::outcome::SolverSettings;
-use knotrod::study::run::run_scene;
 use knotrod::study::start::starting_equilibrium;
 use nalgebra::DMatrix;
+
+mod common;
+use common::{run, scene_at};
 
 /// The double ring (z* = δ = 0, φ = 2π) of `kind` at N segments, relaxed.
 fn double_ring(kind: &str, segments: usize) -> (Minimizer, RodState) {
@@ -192,16 +193,8 @@ fn max_u2(energy: &RodEnergy, state: &RodState) -> f64 {
 
 #[test]
 fn figure_8_strip_branches_at_n_100() {
-    let text = std::fs::read_to_string("scenes/fig8_strip.toml").unwrap();
-    let text = text.replace("segments = 200", "segments = 100");
-    let text = text.split("[output]").next().unwrap();
-    let scene = Scene::parse(text).unwrap();
-    let mut eqs: Vec<Equilibrium> = Vec::new();
-    let events: Vec<Event> = run_scene(&scene, None, &mut |e| {
-        eqs.push(e);
-        Ok(())
-    })
-    .unwrap();
+    let scene = scene_at("scenes/fig8_strip.toml", 100);
+    let (eqs, events) = run(&scene);
     assert!(eqs.len() > 400, "{} points", eqs.len());
     for e in &eqs {
         assert!(e.converged);

@@ -97,9 +97,38 @@ pub fn run(scenes: &Path) -> Result<Report> {
     let d = Scene::load(&scenes.join("appendix_d.toml"))?;
     let fig3 = Scene::load(&scenes.join("fig3_kirchhoff.toml"))?;
     let fig7 = Scene::load(&scenes.join("fig7_island_kirchhoff.toml"))?;
+    let mut workloads = branch_workloads(&d, &fig3)?;
+    workloads.extend(island_workloads(&fig7)?);
+    // per-operation costs on the Appendix D knot resampled at each N
+    let mut per: BTreeMap<String, Vec<(usize, f64)>> = BTreeMap::new();
+    for n in [200, 400, 800, 1600, 3200] {
+        let e = crate::study::start::solve_scene(&d, Some(n))?;
+        let state: RodState = e.state.clone();
+        let mut push = |name: &str, t: f64| per.entry(name.to_string()).or_default().push((n, t));
+        linear_algebra_costs(&d, n, &state, &mut push);
+        geometry_costs(&d, &e, &state, &mut push);
+    }
+    let exponents = per
+        .iter()
+        .map(|(k, v)| {
+            let (n0, t0) = v.first().copied().unwrap();
+            let (n1, t1) = v.last().copied().unwrap();
+            (k.clone(), (t1 / t0).ln() / (n1 as f64 / n0 as f64).ln())
+        })
+        .collect();
+    Ok(Report {
+        workloads,
+        exponents,
+        per_call: per,
+    })
+}
+
+/// The Appendix D knot solved from its shooting data, and the Figure 3
+/// branch continued with and without eigenvalues.
+fn branch_workloads(d: &Scene, fig3: &Scene) -> Result<Vec<Workload>> {
     let mut workloads = Vec::new();
     workloads.push(timed("appendix_d_from_shooting", 200, || {
-        crate::study::start::solve_scene(&d, Some(200))
+        crate::study::start::solve_scene(d, Some(200))
             .map(|_| ())
             .map_err(Into::into)
     })?);
@@ -122,6 +151,13 @@ pub fn run(scenes: &Path) -> Result<Report> {
             .map(|_| ())
             .map_err(Into::into)
     })?);
+    Ok(workloads)
+}
+
+/// The Figure 7-left island: six grid lines, the whole map, and the
+/// boundary walk alone.
+fn island_workloads(fig7: &Scene) -> Result<Vec<Workload>> {
+    let mut workloads = Vec::new();
     let mut island = fig7.clone();
     if let Some(m) = island.map.as_mut() {
         m.lines = 6;
@@ -149,10 +185,10 @@ pub fn run(scenes: &Path) -> Result<Report> {
         let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
         let cache = std::env::temp_dir().join(format!("knotrod-bench-map-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&cache);
-        let t = crate::io::map_files::trace_cached(&fig7, &spec, None, &cache, &|_, _| {})?;
+        let t = crate::io::map_files::trace_cached(fig7, &spec, None, &cache, &|_, _| {})?;
         let idx: Vec<usize> = (0..spec.lines).collect();
         crate::study::map::compute_lines(
-            &fig7,
+            fig7,
             &spec,
             &idx,
             None,
@@ -167,103 +203,99 @@ pub fn run(scenes: &Path) -> Result<Report> {
     })?);
     workloads.push(timed("figure_7_island_boundary_walk", 100, || {
         let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
-        let t = crate::study::boundary::trace_island(&fig7, &spec, None, &|_, _| {})?;
+        let t = crate::study::boundary::trace_island(fig7, &spec, None, &|_, _| {})?;
         if !t.closed {
             anyhow::bail!("boundary walk did not close: {:?}", t.stopped);
         }
         Ok(())
     })?);
-    // per-operation costs on the Appendix D knot resampled at each N
-    let mut per: BTreeMap<String, Vec<(usize, f64)>> = BTreeMap::new();
-    for n in [200, 400, 800, 1600, 3200] {
-        let e = crate::study::start::solve_scene(&d, Some(n))?;
-        let state: RodState = e.state.clone();
-        let energy = RodEnergy::new(d.rod_model(Some(n)));
-        let mut g = vec![0.0; energy.map.len()];
-        let mut v = vec![0.0; energy.pattern.nnz()];
-        energy.hessian(&state, &mut g, &mut v);
-        let mut ldlt = Ldlt::new(&energy.pattern);
-        let mut push = |name: &str, t: f64| per.entry(name.to_string()).or_default().push((n, t));
-        push(
-            "energy",
-            per_call(|| {
-                energy.energy(&state);
-            }),
-        );
-        push(
-            "gradient",
-            per_call(|| {
-                energy.gradient(&state, &mut g);
-            }),
-        );
-        push(
-            "hessian",
-            per_call(|| {
-                energy.hessian(&state, &mut g, &mut v);
-            }),
-        );
-        push(
-            "factorization",
-            per_call(|| {
-                ldlt.factor(&v).unwrap();
-            }),
-        );
-        push(
-            "lowest_eigenvalues",
-            per_call(|| {
-                lowest_eigenvalues(&energy.pattern, &v, None, 4, &mut ldlt).unwrap();
-            }),
-        );
-        let (p, arc) = state.centreline();
-        let closed = ray_closure(&p, -nalgebra::Vector3::z(), nalgebra::Vector3::z(), 1e6);
-        push(
-            "writhe_at_passages",
-            per_call(|| {
-                writhe_closed(&closed);
-            }),
-        );
-        let short = ray_closure(&p, -nalgebra::Vector3::z(), nalgebra::Vector3::z(), 3.0);
-        push(
-            "knot_type_at_passages",
-            per_call(|| {
-                knot_type(&short);
-            }),
-        );
-        push(
-            "self_distance",
-            per_call(|| {
-                min_self_distance(&p, &arc, 0.05);
-            }),
-        );
-        let m = d.measure();
-        // per continuation step: writhe and knot type carried from the
-        // previous point (the full O(N²) ones run only where strands meet)
-        push(
-            "diagnostics_per_step",
-            per_call(|| {
-                Conformation::continued(&state, &m, &e);
-            }),
-        );
-        push(
-            "diagnostics_full",
-            per_call(|| {
-                Conformation::of(&state, &m);
-            }),
-        );
-    }
-    let exponents = per
-        .iter()
-        .map(|(k, v)| {
-            let (n0, t0) = v.first().copied().unwrap();
-            let (n1, t1) = v.last().copied().unwrap();
-            (k.clone(), (t1 / t0).ln() / (n1 as f64 / n0 as f64).ln())
-        })
-        .collect();
-    Ok(Report {
-        workloads,
-        exponents,
-        per_call: per,
-    })
+    Ok(workloads)
+}
+
+/// Seconds per call of the energy, its derivatives, the factorisation and
+/// the lowest eigenvalues at `state`.
+fn linear_algebra_costs(d: &Scene, n: usize, state: &RodState, push: &mut impl FnMut(&str, f64)) {
+    let energy = RodEnergy::new(d.rod_model(Some(n)));
+    let mut g = vec![0.0; energy.map.len()];
+    let mut v = vec![0.0; energy.pattern.nnz()];
+    energy.hessian(state, &mut g, &mut v);
+    let mut ldlt = Ldlt::new(&energy.pattern);
+    push(
+        "energy",
+        per_call(|| {
+            energy.energy(state);
+        }),
+    );
+    push(
+        "gradient",
+        per_call(|| {
+            energy.gradient(state, &mut g);
+        }),
+    );
+    push(
+        "hessian",
+        per_call(|| {
+            energy.hessian(state, &mut g, &mut v);
+        }),
+    );
+    push(
+        "factorization",
+        per_call(|| {
+            ldlt.factor(&v).unwrap();
+        }),
+    );
+    push(
+        "lowest_eigenvalues",
+        per_call(|| {
+            lowest_eigenvalues(&energy.pattern, &v, None, 4, &mut ldlt).unwrap();
+        }),
+    );
+}
+
+/// Seconds per call of the writhe, knot type, self-distance and diagnostics
+/// at `state` (the equilibrium `e`).
+fn geometry_costs(
+    d: &Scene,
+    e: &crate::analysis::equilibrium::Equilibrium,
+    state: &RodState,
+    push: &mut impl FnMut(&str, f64),
+) {
+    let (p, arc) = state.centreline();
+    let closed = ray_closure(&p, -nalgebra::Vector3::z(), nalgebra::Vector3::z(), 1e6);
+    push(
+        "writhe_at_passages",
+        per_call(|| {
+            writhe_closed(&closed);
+        }),
+    );
+    let short = ray_closure(&p, -nalgebra::Vector3::z(), nalgebra::Vector3::z(), 3.0);
+    push(
+        "knot_type_at_passages",
+        per_call(|| {
+            knot_type(&short);
+        }),
+    );
+    push(
+        "self_distance",
+        per_call(|| {
+            min_self_distance(&p, &arc, 0.05);
+        }),
+    );
+    let m = d.measure();
+    // per continuation step: writhe and knot type carried from the
+    // previous point (the full O(N²) ones run only where strands meet)
+    push(
+        "diagnostics_per_step",
+        per_call(|| {
+            Conformation::continued(state, &m, e);
+        }),
+    );
+    push(
+        "diagnostics_full",
+        per_call(|| {
+            Conformation::of(state, &m);
+        }),
+    );
 }
 
 /// Print a report as tables.
