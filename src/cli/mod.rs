@@ -2,8 +2,8 @@
 
 use crate::geometry::closure::{extent, ray_closure};
 use crate::geometry::knot::knot_type;
-use crate::geometry::polyline::read_points;
 use crate::geometry::writhe::writhe_closed;
+use crate::io::curve_file::read_points;
 use crate::io::plot::{PlotPoint, bifurcation_diagram};
 use crate::io::summary::{Summary, print_equilibrium, print_events};
 use crate::report::validation;

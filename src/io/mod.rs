@@ -1,6 +1,7 @@
 //! Files: scene files, restart states, MCAP recordings (writer, reader,
 //! Foxglove geometry), JSON summaries and map files, plots, exports.
 
+pub mod curve_file;
 pub mod export;
 pub mod map_files;
 pub mod plot;

@@ -6,9 +6,9 @@
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
+use crate::report::error::{Result, fail};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolverSettings;
-use anyhow::{Result, ensure};
 use std::f64::consts::PI;
 
 /// The straight (uniformly twisted) equilibrium for `clamps`, stable or not,
@@ -31,10 +31,9 @@ fn loss_of_stability(
     mut hi: f64,
     mut unstable: impl FnMut(f64) -> Result<bool>,
 ) -> Result<f64> {
-    ensure!(
-        !unstable(lo)? && unstable(hi)?,
-        "bracket [{lo}, {hi}] does not contain the loss of stability"
-    );
+    if !(!unstable(lo)? && unstable(hi)?) {
+        fail!("bracket [{lo}, {hi}] does not contain the loss of stability");
+    }
     for _ in 0..40 {
         let mid = 0.5 * (lo + hi);
         if unstable(mid)? { hi = mid } else { lo = mid }

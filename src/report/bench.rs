@@ -11,8 +11,8 @@ use crate::linalg::eigen::lowest_eigenvalues;
 use crate::linalg::sparse::Ldlt;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::RodState;
+use crate::report::error::{Context, Result};
 use crate::scene::Scene;
-use anyhow::{Context, Result};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -197,7 +197,7 @@ fn island_workloads(fig7: &Scene) -> Result<Vec<Workload>> {
         )?;
         let _ = std::fs::remove_dir_all(&cache);
         if !t.closed {
-            anyhow::bail!("boundary walk did not close: {:?}", t.stopped);
+            crate::report::error::fail!("boundary walk did not close: {:?}", t.stopped);
         }
         Ok(())
     })?);
@@ -205,7 +205,7 @@ fn island_workloads(fig7: &Scene) -> Result<Vec<Workload>> {
         let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
         let t = crate::study::boundary::trace_island(fig7, &spec, None, &|_, _| {})?;
         if !t.closed {
-            anyhow::bail!("boundary walk did not close: {:?}", t.stopped);
+            crate::report::error::fail!("boundary walk did not close: {:?}", t.stopped);
         }
         Ok(())
     })?);

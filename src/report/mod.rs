@@ -3,4 +3,5 @@
 
 pub mod analytic;
 pub mod bench;
+pub mod error;
 pub mod validation;

@@ -5,9 +5,9 @@ use super::format::order;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::report::analytic::{euler_buckling_load, greenhill_constant, greenhill_twisting_moment};
+use crate::report::error::Result;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolverSettings;
-use anyhow::Result;
 use std::f64::consts::PI;
 use std::fmt::Write;
 

@@ -1,8 +1,8 @@
 //! Near the double ring: curves I and II against the asymptotic formulas,
 //! and the largest z* of the one-contact curve.
 
+use crate::report::error::Result;
 use crate::study::asymptotics::{curve_i, curve_ii, max_one_contact_z_star, one_contact_shifts};
-use anyhow::Result;
 use std::fmt::Write;
 
 /// The section "Near the double ring: curves I and II".

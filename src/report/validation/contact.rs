@@ -4,7 +4,7 @@ use super::runs::{run_text, scene_text};
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
 use crate::analysis::event::EventKind;
-use anyhow::{Context, Result};
+use crate::report::error::{Context, Result};
 use std::fmt::Write;
 use std::path::Path;
 

@@ -5,9 +5,9 @@ use super::format::{error_cells, norm3};
 use crate::analysis::equilibrium::Equilibrium;
 use crate::model::rod::RodModel;
 use crate::model::shooting::{ShootingSolution, refine_shooting};
+use crate::report::error::{Context, Result};
 use crate::scene::{InitialShape, Scene};
 use crate::study::start::solve_scene;
-use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use std::fmt::Write;
 

@@ -3,8 +3,8 @@
 
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Law, RodModel};
+use crate::report::error::Result;
 use crate::scene::Scene;
-use anyhow::Result;
 use std::fmt::Write;
 
 /// The section "The double ring's stability".

@@ -2,8 +2,8 @@
 
 use super::format::order;
 use crate::analysis::event::EventKind;
+use crate::report::error::Result;
 use crate::scene::Scene;
-use anyhow::Result;
 use std::fmt::Write;
 
 /// The section "Figure 3: events along the branch".

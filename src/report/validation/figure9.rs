@@ -1,10 +1,10 @@
 //! Figure 9: the good knots of the strip in (δ, z*, φ), one island map per
 //! slice of δ.
 
+use crate::report::error::{Context, Result};
 use crate::scene::Scene;
 use crate::scene::SliceSpec;
 use crate::study::map::Map3;
-use anyhow::{Context, Result};
 use std::fmt::Write;
 use std::path::Path;
 

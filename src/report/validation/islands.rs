@@ -1,11 +1,11 @@
 //! Figure 7: the islands of good knots, the grid of lines against the
 //! boundary traced by two-parameter continuation.
 
+use crate::report::error::{Context, Result};
 use crate::scene::MapSpec;
 use crate::scene::Scene;
 use crate::study::boundary::Traced;
 use crate::study::map::{Line, Map};
-use anyhow::{Context, Result};
 use std::fmt::Write;
 use std::path::Path;
 

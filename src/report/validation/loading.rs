@@ -3,7 +3,7 @@
 
 use super::runs::{run_text, scene_text};
 use crate::analysis::event::EventKind;
-use anyhow::Result;
+use crate::report::error::Result;
 use std::fmt::Write;
 use std::path::Path;
 

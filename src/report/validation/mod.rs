@@ -20,8 +20,8 @@ mod strip;
 
 pub use convergence::{continuum_reference, convergence_table};
 
+use crate::report::error::Result;
 use crate::scene::Scene;
-use anyhow::Result;
 use std::fmt::Write;
 use std::path::Path;
 

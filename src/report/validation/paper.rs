@@ -5,9 +5,9 @@ use crate::analysis::equilibrium::Equilibrium;
 use crate::geometry::closure::ray_closure;
 use crate::geometry::writhe::writhe_closed;
 use crate::io::summary::relative_deviation;
+use crate::report::error::{Context, Result};
 use crate::scene::{ReferenceSpec, Scene};
 use crate::study::start::solve_scene;
-use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use std::fmt::Write;
 

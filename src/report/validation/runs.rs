@@ -1,7 +1,7 @@
 //! Scenes run from their TOML text, for tables that vary a scene file.
 
+use crate::report::error::Result;
 use crate::scene::Scene;
-use anyhow::Result;
 use std::path::Path;
 
 /// Runs a scene given as TOML text and returns its equilibria and events.

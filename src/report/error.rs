@@ -1,0 +1,97 @@
+//! Why a report could not be made: the typed error of the report entry
+//! points, with the steps it was in (as a chain of sources).
+
+use crate::analysis::equilibrium::AnalysisError;
+use crate::io::map_files::MapFileError;
+use crate::linalg::eigen::StabilityError;
+use crate::scene::SceneError;
+use crate::solve::continuation::ContinuationError;
+use crate::solve::outcome::SolveError;
+use crate::study::error::StudyError;
+
+/// A report that could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// A study behind it failed.
+    #[error(transparent)]
+    Study(#[from] StudyError),
+    /// A scene could not be used.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A map's files could not be used.
+    #[error(transparent)]
+    MapFile(#[from] MapFileError),
+    /// A minimisation failed.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// A continuation step failed.
+    #[error(transparent)]
+    Continuation(#[from] ContinuationError),
+    /// A stability analysis failed.
+    #[error(transparent)]
+    Stability(#[from] StabilityError),
+    /// Measuring an equilibrium failed.
+    #[error(transparent)]
+    Analysis(#[from] AnalysisError),
+    /// Writing the text failed.
+    #[error("writing the report: {0}")]
+    Format(#[from] std::fmt::Error),
+    /// Writing to the terminal or a file failed.
+    #[error("writing the report: {0}")]
+    Write(#[from] std::io::Error),
+    /// A check that could not be made, saying why.
+    #[error("{0}")]
+    Failed(String),
+    /// What the report was doing when its cause failed.
+    #[error("{step}")]
+    At {
+        /// The step.
+        step: String,
+        /// What failed there.
+        #[source]
+        source: Box<ReportError>,
+    },
+}
+
+/// A report's result.
+pub type Result<T, E = ReportError> = std::result::Result<T, E>;
+
+/// Name the step an error happened in.
+pub trait Context<T> {
+    /// The error, said to have happened in `step`.
+    fn context(self, step: impl Into<String>) -> Result<T>;
+    /// As [`Context::context`], the step made only on failure.
+    fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T>;
+}
+
+impl<T, E: Into<ReportError>> Context<T> for std::result::Result<T, E> {
+    fn context(self, step: impl Into<String>) -> Result<T> {
+        self.map_err(|e| ReportError::At {
+            step: step.into(),
+            source: Box::new(e.into()),
+        })
+    }
+    fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T> {
+        self.map_err(|e| ReportError::At {
+            step: step().into(),
+            source: Box::new(e.into()),
+        })
+    }
+}
+
+impl<T> Context<T> for Option<T> {
+    fn context(self, step: impl Into<String>) -> Result<T> {
+        self.ok_or_else(|| ReportError::Failed(step.into()))
+    }
+    fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T> {
+        self.ok_or_else(|| ReportError::Failed(step().into()))
+    }
+}
+
+/// Stop a report with a message.
+macro_rules! fail {
+    ($($t:tt)*) => {
+        return Err($crate::report::error::ReportError::Failed(format!($($t)*)))
+    };
+}
+pub(crate) use fail;
