@@ -33,7 +33,6 @@ fn root() -> PathBuf {
 /// the trailing test module removed).
 struct File {
     module: Vec<String>,
-    is_mod_rs: bool,
     code: String,
 }
 
@@ -73,8 +72,7 @@ fn read_crate() -> BTreeMap<PathBuf, File> {
                 .iter()
                 .map(|c| c.to_string_lossy().into_owned())
                 .collect();
-            let is_mod_rs = module.last().is_some_and(|m| m == "mod");
-            if is_mod_rs {
+            if module.last().is_some_and(|m| m == "mod") {
                 module.pop();
             }
             let code = strip(&std::fs::read_to_string(&p).unwrap());
@@ -106,12 +104,8 @@ fn uses(file: &File) -> Vec<(Vec<String>, bool)> {
                 .map(str::to_string)
         })
         .collect();
-    // the module `super::` names, and the one that bare child paths start in
-    let here = if file.is_mod_rs {
-        file.module.clone()
-    } else {
-        file.module.clone()
-    };
+    // bare child paths start in this module, `super::` in its parent
+    let here = file.module.clone();
     let parent = {
         let mut p = file.module.clone();
         p.pop();
@@ -243,10 +237,12 @@ fn resolve(files: &BTreeMap<PathBuf, File>, path: &[String], depth: usize) -> Op
     }
     let name = &path[len];
     for (target, public) in uses(&files[&file]) {
-        if public && target.last() == Some(name) && target.len() > len {
-            if let Some(f) = resolve(files, &target, depth + 1) {
-                return Some(f);
-            }
+        if public
+            && target.last() == Some(name)
+            && target.len() > len
+            && let Some(f) = resolve(files, &target, depth + 1)
+        {
+            return Some(f);
         }
     }
     Some(file)
@@ -407,7 +403,6 @@ fn the_reader_sees_imports_through_groups_super_and_re_exports() {
     // the parser itself, on the forms the crate uses
     let f = File {
         module: vec!["study".into(), "boundary".into()],
-        is_mod_rs: true,
         code: "mod walk;\npub use walk::trace_island;\nuse crate::scene::{MapSpec, Scene};\nuse super::map::Line;\nlet x = crate::linalg::sparse::Ldlt::new();".into(),
     };
     let got: Vec<(Vec<String>, bool)> = uses(&f);

@@ -31,7 +31,7 @@ fn loss_of_stability(
     mut hi: f64,
     mut unstable: impl FnMut(f64) -> Result<bool>,
 ) -> Result<f64> {
-    if !(!unstable(lo)? && unstable(hi)?) {
+    if unstable(lo)? || !unstable(hi)? {
         fail!("bracket [{lo}, {hi}] does not contain the loss of stability");
     }
     for _ in 0..40 {
