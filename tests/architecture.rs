@@ -76,14 +76,7 @@ fn read_crate() -> BTreeMap<PathBuf, File> {
                 module.pop();
             }
             let code = strip(&std::fs::read_to_string(&p).unwrap());
-            (
-                rel,
-                File {
-                    module,
-                    is_mod_rs,
-                    code,
-                },
-            )
+            (rel, File { module, code })
         })
         .collect()
 }
