@@ -1,7 +1,11 @@
 //! Files: scene files, restart states, MCAP recordings (writer, reader,
 //! Foxglove geometry), JSON summaries and map files, plots, exports.
 
+pub mod error;
 pub mod export;
+pub mod json;
 pub mod plot;
 pub mod recording;
 pub mod summary;
+
+pub use error::IoError;

@@ -5,8 +5,8 @@
 //! TrueType font is found for the labels.
 
 use crate::analysis::equilibrium::Equilibrium;
+use crate::io::error::{IoError, Result};
 use crate::study::branch::Event;
-use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -132,7 +132,8 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(|e| anyhow!("{e:?}"))?;
+    root.fill(&WHITE)
+        .map_err(|e| IoError::Plot(format!("{e:?}")))?;
     let (top, bottom) = root.split_vertically((root.dim_in_pixel().1 as f64 * 0.55) as u32);
     let (mid, low) = bottom.split_vertically(bottom.dim_in_pixel().1 / 2);
     let finite = |v: f64| v.is_finite();
@@ -140,7 +141,7 @@ where
     let (x0, x1) = bounds(&xs);
     let tw: Vec<f64> = eqs.iter().map(|e| e.twist).collect();
     let (y0, y1) = bounds(&tw);
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plot: {e:?}");
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     let mut chart = ChartBuilder::on(&top)
         .caption(title, ("sans-serif", 18))
         .margin(8)
@@ -328,7 +329,8 @@ pub fn island_slices(
     let svg = stem.with_extension("svg");
     {
         let root = SVGBackend::new(&svg, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e:?}"))?;
+        root.fill(&WHITE)
+            .map_err(|e| IoError::Plot(format!("{e:?}")))?;
         for (area, m) in root.split_evenly((rows, cols)).into_iter().zip(&map.slices) {
             draw_map(area, m)?;
         }
@@ -338,7 +340,8 @@ pub fn island_slices(
         let png = stem.with_extension("png");
         {
             let root = BitMapBackend::new(&png, size).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| anyhow!("plot: {e:?}"))?;
+            root.fill(&WHITE)
+                .map_err(|e| IoError::Plot(format!("{e:?}")))?;
             for (area, m) in root.split_evenly((rows, cols)).into_iter().zip(&map.slices) {
                 draw_map(area, m)?;
             }
@@ -356,7 +359,7 @@ where
     DB::ErrorType: 'static,
 {
     use crate::study::map::Class;
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plot: {e:?}");
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     root.fill(&WHITE).map_err(err)?;
     let (x0, x1) = bounds(&map.grid_phi);
     let values: Vec<f64> = map.lines.iter().map(|l| l.value).collect();
