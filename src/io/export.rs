@@ -1,14 +1,32 @@
 //! Reading recordings back: `knotrod info` and `knotrod export`.
 
-use crate::cli::ExportFormat;
-use crate::io::recording::{read_recording, read_state};
-use anyhow::{Context, Result};
+use crate::io::error::{IoError, Result};
+use crate::io::recording::{StateMessage, read_recording, read_state};
 use std::io::Write;
 use std::path::Path;
+
+/// Export formats of one recorded state.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum ExportFormat {
+    /// Nodes and material frames, one row per node.
+    Csv,
+    /// The full state.
+    Json,
+    /// A triangle mesh of the tube.
+    Obj,
+}
 
 /// Print what a recording holds.
 pub fn info(path: &Path, out: &mut impl Write) -> Result<()> {
     let rec = read_recording(path)?;
+    print_info(path, &rec, out).map_err(IoError::Output)
+}
+
+fn print_info(
+    path: &Path,
+    rec: &crate::io::recording::Recording,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
     writeln!(out, "recording {}", path.display())?;
     if let Some(v) = rec.metadata.get("knotrod_version") {
         writeln!(
@@ -56,54 +74,65 @@ pub fn info(path: &Path, out: &mut impl Write) -> Result<()> {
 /// Export one recorded state.
 pub fn export(path: &Path, index: u64, format: ExportFormat, out: Option<&Path>) -> Result<()> {
     let msg = read_state(path, index)?;
-    let s = &msg.state;
-    let mut text = String::new();
-    use std::fmt::Write as _;
-    match format {
-        ExportFormat::Json => text = serde_json::to_string_pretty(&msg)?,
-        ExportFormat::Csv => {
-            writeln!(text, "node,s,x,y,z,d1x,d1y,d1z,d2x,d2y,d2z")?;
-            let (points, arc) = s.centreline();
-            let n = s.segments();
-            for (k, (p, a)) in points.iter().zip(&arc).enumerate() {
-                // the frame of the edge starting at this point (clamp frame at the ends)
-                let j = k.min(n);
-                let [d1, d2, _] = s.directors(j);
-                writeln!(
-                    text,
-                    "{k},{a},{},{},{},{},{},{},{},{},{}",
-                    p.x, p.y, p.z, d1.x, d1.y, d1.z, d2.x, d2.y, d2.z
-                )?;
-            }
-        }
-        ExportFormat::Obj => {
-            // a tube around the centreline, 12 sides, of the diameter of the
-            // solid circular rod with this stretching stiffness (S = 16/h²)
-            let radius = 2.0 / msg.model.stretching_stiffness.sqrt();
-            let (points, _) = s.centreline();
-            let sides = 12;
-            writeln!(text, "# knotrod state {index} of {}", path.display())?;
-            let n = s.segments();
-            for (k, p) in points.iter().enumerate() {
-                let [d1, d2, _] = s.directors(k.min(n));
-                for q in 0..sides {
-                    let a = 2.0 * std::f64::consts::PI * q as f64 / sides as f64;
-                    let v = p + radius * (a.cos() * d1 + a.sin() * d2);
-                    writeln!(text, "v {} {} {}", v.x, v.y, v.z)?;
-                }
-            }
-            for k in 0..points.len() - 1 {
-                for q in 0..sides {
-                    let (a, b) = (k * sides + q + 1, k * sides + (q + 1) % sides + 1);
-                    let (c, d) = (a + sides, b + sides);
-                    writeln!(text, "f {a} {b} {d} {c}")?;
-                }
-            }
-        }
-    }
+    let text = match format {
+        ExportFormat::Json => serde_json::to_string_pretty(&msg)
+            .map_err(IoError::json("cannot encode the state as JSON", path))?,
+        ExportFormat::Csv => csv(&msg),
+        ExportFormat::Obj => obj(&msg, path, index),
+    };
     match out {
-        Some(p) => std::fs::write(p, text).with_context(|| format!("writing {}", p.display()))?,
-        None => std::io::stdout().lock().write_all(text.as_bytes())?,
+        Some(p) => std::fs::write(p, text).map_err(IoError::file("writing", p)),
+        None => std::io::stdout()
+            .lock()
+            .write_all(text.as_bytes())
+            .map_err(IoError::Output),
     }
-    Ok(())
+}
+
+/// Nodes and material frames, one row per node.
+fn csv(msg: &StateMessage) -> String {
+    use std::fmt::Write as _;
+    let s = &msg.state;
+    let mut text = String::from("node,s,x,y,z,d1x,d1y,d1z,d2x,d2y,d2z\n");
+    let (points, arc) = s.centreline();
+    let n = s.segments();
+    for (k, (p, a)) in points.iter().zip(&arc).enumerate() {
+        // the frame of the edge starting at this point (clamp frame at the ends)
+        let j = k.min(n);
+        let [d1, d2, _] = s.directors(j);
+        let _ = writeln!(
+            text,
+            "{k},{a},{},{},{},{},{},{},{},{},{}",
+            p.x, p.y, p.z, d1.x, d1.y, d1.z, d2.x, d2.y, d2.z
+        );
+    }
+    text
+}
+
+/// A tube around the centreline, 12 sides, of the diameter of the solid
+/// circular rod with this stretching stiffness (S = 16/h²).
+fn obj(msg: &StateMessage, path: &Path, index: u64) -> String {
+    use std::fmt::Write as _;
+    let s = &msg.state;
+    let radius = 2.0 / msg.model.stretching_stiffness.sqrt();
+    let (points, _) = s.centreline();
+    let sides = 12;
+    let mut text = format!("# knotrod state {index} of {}\n", path.display());
+    let n = s.segments();
+    for (k, p) in points.iter().enumerate() {
+        let [d1, d2, _] = s.directors(k.min(n));
+        for q in 0..sides {
+            let a = 2.0 * std::f64::consts::PI * q as f64 / sides as f64;
+            let v = p + radius * (a.cos() * d1 + a.sin() * d2);
+            let _ = writeln!(text, "v {} {} {}", v.x, v.y, v.z);
+        }
+    }
+    for k in 0..points.len() - 1 {
+        for q in 0..sides {
+            let (a, b) = (k * sides + q + 1, k * sides + (q + 1) % sides + 1);
+            let (c, d) = (a + sides, b + sides);
+            let _ = writeln!(text, "f {a} {b} {d} {c}");
+        }
+    }
+    text
 }

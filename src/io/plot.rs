@@ -7,7 +7,7 @@
 use crate::analysis::class::{Class, is_trefoil};
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
-use anyhow::{Result, anyhow};
+use crate::io::error::{IoError, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -141,7 +141,8 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(|e| anyhow!("{e:?}"))?;
+    root.fill(&WHITE)
+        .map_err(|e| IoError::Plot(format!("{e:?}")))?;
     let (top, bottom) = root.split_vertically((root.dim_in_pixel().1 as f64 * 0.55) as u32);
     let (mid, low) = bottom.split_vertically(bottom.dim_in_pixel().1 / 2);
     let finite = |v: f64| v.is_finite();
@@ -149,7 +150,7 @@ where
     let (x0, x1) = bounds(&xs);
     let tw: Vec<f64> = eqs.iter().map(|e| e.twist).collect();
     let (y0, y1) = bounds(&tw);
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plot: {e:?}");
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     let mut chart = ChartBuilder::on(&top)
         .caption(title, ("sans-serif", 18))
         .margin(8)
@@ -337,7 +338,8 @@ pub fn island_slices(
     let svg = stem.with_extension("svg");
     {
         let root = SVGBackend::new(&svg, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e:?}"))?;
+        root.fill(&WHITE)
+            .map_err(|e| IoError::Plot(format!("{e:?}")))?;
         for (area, m) in root.split_evenly((rows, cols)).into_iter().zip(&map.slices) {
             draw_map(area, m)?;
         }
@@ -347,7 +349,8 @@ pub fn island_slices(
         let png = stem.with_extension("png");
         {
             let root = BitMapBackend::new(&png, size).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| anyhow!("plot: {e:?}"))?;
+            root.fill(&WHITE)
+                .map_err(|e| IoError::Plot(format!("{e:?}")))?;
             for (area, m) in root.split_evenly((rows, cols)).into_iter().zip(&map.slices) {
                 draw_map(area, m)?;
             }
@@ -364,7 +367,7 @@ fn draw_map<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plot: {e:?}");
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     root.fill(&WHITE).map_err(err)?;
     let (x0, x1) = bounds(&map.grid_phi);
     let values: Vec<f64> = map.lines.iter().map(|l| l.value).collect();

@@ -5,6 +5,7 @@
 use crate::io::recording::read_state;
 use crate::model::rod::RodState;
 use crate::scene::{InitialShape, Scene, SceneError};
+use crate::study::error::describe;
 use std::path::Path;
 
 impl Scene {
@@ -47,7 +48,7 @@ fn restart_state(scene: &Scene) -> Result<Option<RodState>, SceneError> {
     let init = &scene.initial;
     if let Some(path) = &init.from_recording {
         let msg = read_state(path, init.index as u64)
-            .map_err(|e| invalid("initial.from_recording", format!("{e:#}")))?;
+            .map_err(|e| invalid("initial.from_recording", describe(&e)))?;
         return Ok(Some(msg.state));
     }
     if init.shape != InitialShape::File {

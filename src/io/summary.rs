@@ -57,17 +57,8 @@ impl Summary {
 
     /// Write as JSON (to a temporary file renamed into place, so a reader never
     /// sees a half-written summary).
-    pub fn write(&self, path: &Path) -> anyhow::Result<()> {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)?;
-        }
-        let tmp = path.with_extension("json.tmp");
-        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-        serde_json::to_writer_pretty(&mut f, self)?;
-        f.write_all(b"\n")?;
-        f.into_inner()?.sync_all()?;
-        std::fs::rename(&tmp, path)?;
-        Ok(())
+    pub fn write(&self, path: &Path) -> crate::io::error::Result<()> {
+        crate::io::json::write_pretty(path, self)
     }
 }
 

@@ -1,0 +1,125 @@
+//! `knotrod knot`: writhe and knot type of any curve.
+
+use super::RayKind;
+use crate::geometry::closure::{extent, ray_closure};
+use crate::geometry::knot::{KnotType, knot_type};
+use crate::geometry::writhe::writhe_closed;
+use crate::io::curve_file::read_points;
+use crate::io::json::write_pretty;
+use anyhow::Result;
+use nalgebra::Vector3;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Writhe and knot type of a curve file, printed or as JSON.
+pub fn knot(path: &Path, closed: bool, rays: RayKind, json: Option<PathBuf>) -> Result<()> {
+    let points = read_points(path)?;
+    let (writhe, kt) = writhe_and_knot(&points, closed, rays);
+    let answer = serde_json::json!({
+        "curve": path.display().to_string(),
+        "points": points.len(),
+        "closed": closed,
+        "writhe": writhe,
+        "knot_determinant": kt.determinant,
+        "alexander": kt.alexander,
+        "knot_name": kt.name,
+        "crossings": kt.crossings,
+        "projections": kt.directions,
+        "ambiguous": kt.ambiguous,
+    });
+    let mut out = std::io::stdout().lock();
+    match json {
+        Some(p) if p.as_os_str() == "-" => {
+            writeln!(out, "{}", serde_json::to_string_pretty(&answer)?)?
+        }
+        other => {
+            let closure = if closed { "closed" } else { "closed by rays" };
+            let head = format!(
+                "curve {} ({} points, {closure})",
+                path.display(),
+                points.len()
+            );
+            print_knot(&head, writhe, &kt, &mut out)?;
+            if let Some(p) = other {
+                write_pretty(&p, &answer)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Writhe and knot type of a closed curve, or of an open one closed by rays.
+fn writhe_and_knot(points: &[Vector3<f64>], closed: bool, rays: RayKind) -> (f64, KnotType) {
+    if closed {
+        return (writhe_closed(points), knot_type(points));
+    }
+    let m = points.len();
+    let (bottom, top) = match rays {
+        RayKind::Tangent => (points[0] - points[1], points[m - 1] - points[m - 2]),
+        RayKind::Z => (-Vector3::z(), Vector3::z()),
+    };
+    let size = extent(points).max(1e-300);
+    // writhe error of the closure decays as 1/(ray length)
+    let w = writhe_closed(&ray_closure(points, bottom, top, 1e6 * size));
+    (
+        w,
+        knot_type(&ray_closure(
+            points,
+            bottom,
+            top,
+            2.0 * size + size.max(1.0),
+        )),
+    )
+}
+
+/// The answer for people.
+fn print_knot(head: &str, writhe: f64, kt: &KnotType, out: &mut impl Write) -> Result<()> {
+    writeln!(out, "{head}")?;
+    writeln!(out, "  writhe {writhe:.6}")?;
+    writeln!(out, "  knot determinant {}", kt.determinant)?;
+    writeln!(out, "  Alexander polynomial {}", polynomial(&kt.alexander))?;
+    writeln!(
+        out,
+        "  likely knot {}",
+        kt.name
+            .as_deref()
+            .unwrap_or("not in the table (more than 7 crossings?)")
+    )?;
+    if kt.ambiguous {
+        writeln!(
+            out,
+            "  AMBIGUOUS: projections disagree or are degenerate (the curve may pass through itself)"
+        )?;
+    }
+    Ok(())
+}
+
+/// Δ(t) as text, e.g. "1 - t + t^2".
+fn polynomial(c: &[i64]) -> String {
+    if c.is_empty() {
+        return "unknown".into();
+    }
+    let mut s = String::new();
+    for (j, &a) in c.iter().enumerate().filter(|(_, a)| **a != 0) {
+        let mag = a.unsigned_abs();
+        let sign = if a < 0 { "-" } else { "+" };
+        if s.is_empty() {
+            if a < 0 {
+                s.push('-');
+            }
+        } else {
+            s += &format!(" {sign} ");
+        }
+        let coef = if mag == 1 && j > 0 {
+            String::new()
+        } else {
+            mag.to_string()
+        };
+        s += &match j {
+            0 => mag.to_string(),
+            1 => format!("{coef}t"),
+            _ => format!("{coef}t^{j}"),
+        };
+    }
+    s
+}

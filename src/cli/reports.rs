@@ -1,0 +1,35 @@
+//! `knotrod bench`, `knotrod validate` and `knotrod convergence`: the reports.
+
+use crate::io::json::write_pretty;
+use crate::report::validation;
+use crate::scene::Scene;
+use anyhow::Result;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Time the standard workloads; print the report, and write it as JSON.
+pub fn bench(scenes: &Path, json: Option<PathBuf>) -> Result<()> {
+    let r = crate::report::bench::run(scenes)?;
+    crate::report::bench::print(&r, &mut std::io::stdout().lock())?;
+    if let Some(p) = json {
+        write_pretty(&p, &r)?;
+    }
+    Ok(())
+}
+
+/// Print the validation report.
+pub fn validate(scenes: &Path) -> Result<()> {
+    write!(std::io::stdout().lock(), "{}", validation::report(scenes)?)?;
+    Ok(())
+}
+
+/// Print the convergence table in N of a scene's equilibrium.
+pub fn convergence(path: &Path, segments: &[usize]) -> Result<()> {
+    let scene = Scene::load(path)?;
+    write!(
+        std::io::stdout().lock(),
+        "{}",
+        validation::convergence_table(&scene, segments)?
+    )?;
+    Ok(())
+}

@@ -1,0 +1,225 @@
+//! `knotrod run`: solve a scene, streaming every equilibrium to the JSONL file
+//! and the MCAP recording as it is computed, then print and plot the result
+//! and write the summary.
+
+use crate::analysis::equilibrium::Equilibrium;
+use crate::analysis::event::Event;
+use crate::io::json::create_parent;
+use crate::io::plot::{PlotPoint, bifurcation_diagram};
+use crate::io::recording::Recorder;
+use crate::io::summary::{Summary, print_equilibrium, print_events};
+use crate::model::rod::RodModel;
+use crate::scene::Scene;
+use crate::study::error::StudyError;
+use crate::study::run::run_scene;
+use anyhow::{Context, Result};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Set by Ctrl-C / SIGTERM: the run stops at the next equilibrium and still
+/// finalises its recording and summary.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Solve the scene at `path`. `record`: `None` for no recording, `Some(None)`
+/// for the default file recordings/<scene>.mcap.
+pub fn run(
+    path: &Path,
+    json: Option<PathBuf>,
+    segments: Option<usize>,
+    record: Option<Option<PathBuf>>,
+) -> Result<()> {
+    let scene = Scene::load(path)?;
+    let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
+    if let Some(n) = segments {
+        anyhow::ensure!(
+            (4..=1_000_000).contains(&n),
+            "--segments must be in 4..=1000000, got {n}"
+        );
+    }
+    let model = scene.rod_model(segments);
+    let start = std::time::Instant::now();
+    let json = json.or(scene.output.json.clone());
+    let mut summary = Summary::new(&scene, &model);
+    let mut outputs = Outputs::open(path, &scene, &model, json.as_deref(), record)?;
+    let progress = Progress::new();
+    let result = run_scene(&scene, segments, &mut |eq: Equilibrium| {
+        outputs
+            .equilibrium(&eq)
+            .map_err(|e| StudyError::Observer(e.into()))?;
+        progress.equilibrium(&eq);
+        summary.equilibria.push(eq);
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            return Err(StudyError::Observer(
+                "interrupted (Ctrl-C): stopped after this equilibrium".into(),
+            ));
+        }
+        Ok(())
+    });
+    progress.finish();
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "scene {} — {}, N = {} ({:.2} s, {} equilibria)",
+        summary.scene,
+        model.describe(),
+        model.segments,
+        start.elapsed().as_secs_f64(),
+        summary.equilibria.len()
+    )?;
+    let failed = match result {
+        Ok(events) => {
+            summary.events = events;
+            None
+        }
+        Err(e) => Some(e),
+    };
+    // the recording and the summary are finalised whatever happened, with
+    // what was computed
+    outputs.finish(&summary.events, &mut out)?;
+    report(&scene, &summary, json.as_deref(), &mut out)?;
+    if let Some(path) = &json {
+        summary.write(path)?;
+        writeln!(out, "summary written to {}", path.display())?;
+    }
+    failed.map_or(Ok(()), |e| Err(e.into()))
+}
+
+/// Where a run's equilibria go as they are computed: one JSON line each to
+/// `<json>.jsonl`, and the MCAP recording.
+struct Outputs {
+    /// The JSON lines stream and its file.
+    stream: Option<(BufWriter<File>, PathBuf)>,
+    /// The recording.
+    recorder: Option<Recorder>,
+}
+
+impl Outputs {
+    /// Create the JSONL file beside `json` (if any) and the recording (if
+    /// asked for; `Some(None)` is recordings/<scene>.mcap).
+    fn open(
+        scene_path: &Path,
+        scene: &Scene,
+        model: &RodModel,
+        json: Option<&Path>,
+        record: Option<Option<PathBuf>>,
+    ) -> Result<Self> {
+        let stream = match json {
+            Some(p) => {
+                create_parent(p)?;
+                let lines = p.with_extension("jsonl");
+                let file = File::create(&lines)
+                    .with_context(|| format!("creating {}", lines.display()))?;
+                Some((BufWriter::new(file), lines))
+            }
+            None => None,
+        };
+        let recorder = match record {
+            Some(file) => {
+                let file = file.unwrap_or_else(|| {
+                    PathBuf::from("recordings")
+                        .join(format!("{}.mcap", scene.name.as_deref().unwrap_or("run")))
+                });
+                let text = std::fs::read_to_string(scene_path).unwrap_or_default();
+                Some(Recorder::create(
+                    &file,
+                    &text,
+                    model,
+                    scene.model.rod_diameter,
+                )?)
+            }
+            None => None,
+        };
+        Ok(Outputs { stream, recorder })
+    }
+
+    /// Stream one equilibrium (the line is flushed at once).
+    fn equilibrium(&mut self, eq: &Equilibrium) -> Result<()> {
+        if let Some((w, lines)) = self.stream.as_mut() {
+            let write = |w: &mut BufWriter<File>| -> std::io::Result<()> {
+                serde_json::to_writer(&mut *w, eq)?;
+                w.write_all(b"\n")?;
+                w.flush()
+            };
+            write(w).with_context(|| format!("writing {}", lines.display()))?;
+        }
+        if let Some(r) = self.recorder.as_mut() {
+            r.record(eq)?;
+        }
+        Ok(())
+    }
+
+    /// Record the events, finalise the recording and say where it is.
+    fn finish(self, events: &[Event], out: &mut impl Write) -> Result<()> {
+        if let Some(mut r) = self.recorder {
+            r.events(events)?;
+            let (file, states) = (r.path().to_path_buf(), r.len());
+            r.finish()?;
+            writeln!(
+                out,
+                "recording written to {} ({states} states)",
+                file.display()
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// The spinner showing the last equilibrium computed.
+struct Progress(indicatif::ProgressBar);
+
+impl Progress {
+    fn new() -> Self {
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} {elapsed} {pos} equilibria — {msg}")
+                .unwrap(),
+        );
+        Progress(bar)
+    }
+
+    fn equilibrium(&self, eq: &Equilibrium) {
+        self.0.inc(1);
+        self.0.set_message(format!(
+            "branch {}: z* = {:.4}, δ = {:.4}, φ/2π = {:.4}, Tw = {:.4}{}",
+            eq.branch,
+            eq.z_star,
+            eq.delta,
+            eq.phi_over_2pi,
+            eq.twist,
+            if eq.stable { "" } else { " (unstable)" }
+        ));
+    }
+
+    fn finish(self) {
+        self.0.finish_and_clear();
+    }
+}
+
+/// The result: a single equilibrium in full, or the events of a branch and
+/// its bifurcation diagram (beside the summary, or in recordings/).
+fn report(
+    scene: &Scene,
+    summary: &Summary,
+    json: Option<&Path>,
+    out: &mut impl Write,
+) -> Result<()> {
+    if scene.continuation.is_none() && scene.loading.is_empty() {
+        if let Some(eq) = summary.equilibria.first() {
+            print_equilibrium(eq, scene, out)?;
+        }
+        return Ok(());
+    }
+    print_events(&summary.events, out)?;
+    let stem = json
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("recordings").join(&summary.scene));
+    create_parent(&stem)?;
+    let title = format!("{} (N = {})", summary.scene, summary.segments);
+    let points: Vec<PlotPoint> = summary.equilibria.iter().map(PlotPoint::from).collect();
+    for f in bifurcation_diagram(&stem, &title, &points, &summary.events)? {
+        writeln!(out, "plot written to {}", f.display())?;
+    }
+    Ok(())
+}

@@ -1,0 +1,235 @@
+//! Writing a recording: [`Recorder`].
+
+use super::foxglove::scene_update;
+use super::{
+    EVENT_SCHEMA, EVENTS_TOPIC, SCALARS_SCHEMA, SCALARS_TOPIC, SCENE_TOPIC, STATE_SCHEMA,
+    STATE_TOPIC, Scalars, StateMessage, TF_TOPIC,
+};
+use crate::analysis::equilibrium::Equilibrium;
+use crate::analysis::event::Event;
+use crate::io::error::{IoError, Result};
+use crate::model::rod::RodModel;
+use foxglove::Encode;
+use foxglove::messages::{
+    FrameTransform, Quaternion, SceneUpdate, Timestamp, Vector3 as FgVector3,
+};
+use mcap::records::{MessageHeader, Metadata};
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// An MCAP recording being written. Call [`Recorder::finish`]: dropping it
+/// unfinished leaves a file without its summary.
+pub struct Recorder {
+    writer: Option<Mcap>,
+    path: PathBuf,
+    channels: [u16; 5],
+    count: u64,
+    sequence: u32,
+    rod_diameter: f64,
+    model: RodModel,
+}
+
+fn encode<T: Encode>(m: &T, path: &Path) -> Result<Vec<u8>> {
+    let mut buf = Vec::new();
+    m.encode(&mut buf).map_err(|e| IoError::Recording {
+        path: path.into(),
+        reason: format!("encoding a Foxglove message: {e}"),
+    })?;
+    Ok(buf)
+}
+
+/// An MCAP writer error at `step` on `path`.
+fn mcap_error(step: &'static str, path: &Path) -> impl FnOnce(mcap::McapError) -> IoError {
+    let path = path.to_path_buf();
+    move |source| IoError::Mcap { step, path, source }
+}
+
+/// The MCAP writer of a recording file.
+type Mcap = mcap::Writer<BufWriter<File>>;
+
+/// The five channels, in the order of [`Recorder`]'s `channels`.
+fn add_channels(writer: &mut Mcap, path: &Path) -> Result<[u16; 5]> {
+    let mut channel = |topic: &str,
+                       schema: Option<foxglove::Schema>,
+                       json_title: &str,
+                       json: &str|
+     -> Result<u16> {
+        let (name, encoding, data, msg_enc) = match schema {
+            Some(s) => (s.name, s.encoding, s.data.into_owned(), "protobuf"),
+            None => (
+                json_title.to_string(),
+                "jsonschema".to_string(),
+                json.as_bytes().to_vec(),
+                "json",
+            ),
+        };
+        let sid = writer
+            .add_schema(&name, &encoding, &data)
+            .map_err(mcap_error("adding a schema", path))?;
+        writer
+            .add_channel(sid, topic, msg_enc, &BTreeMap::new())
+            .map_err(mcap_error("adding a channel", path))
+    };
+    Ok([
+        channel(SCENE_TOPIC, SceneUpdate::get_schema(), "", "")?,
+        channel(TF_TOPIC, FrameTransform::get_schema(), "", "")?,
+        channel(SCALARS_TOPIC, None, "knotrod.Scalars", SCALARS_SCHEMA)?,
+        channel(STATE_TOPIC, None, "knotrod.RodState", STATE_SCHEMA)?,
+        channel(EVENTS_TOPIC, None, "knotrod.Event", EVENT_SCHEMA)?,
+    ])
+}
+
+/// The metadata: the scene text, the versions and the model.
+fn write_metadata(
+    writer: &mut Mcap,
+    path: &Path,
+    scene_text: &str,
+    model: &RodModel,
+) -> Result<()> {
+    let mut meta = BTreeMap::new();
+    meta.insert("scene".to_string(), scene_text.to_string());
+    meta.insert(
+        "knotrod_version".to_string(),
+        env!("CARGO_PKG_VERSION").to_string(),
+    );
+    meta.insert(
+        "git_revision".to_string(),
+        env!("KNOTROD_GIT_REVISION").to_string(),
+    );
+    let model_json =
+        serde_json::to_string(model).map_err(IoError::json("encoding the model", path))?;
+    meta.insert("model".to_string(), model_json);
+    writer
+        .write_metadata(&Metadata {
+            name: "knotrod".into(),
+            metadata: meta,
+        })
+        .map_err(mcap_error("writing the metadata", path))
+}
+
+impl Recorder {
+    /// Create `path`, with metadata holding the scene text and versions.
+    pub fn create(
+        path: &Path,
+        scene_text: &str,
+        model: &RodModel,
+        rod_diameter: f64,
+    ) -> Result<Self> {
+        crate::io::json::create_parent(path)?;
+        let file = File::create(path).map_err(IoError::file("creating recording", path))?;
+        let mut writer = mcap::WriteOptions::new()
+            .profile("")
+            .library(format!("knotrod {}", env!("CARGO_PKG_VERSION")))
+            .create(BufWriter::new(file))
+            .map_err(mcap_error("writing the header", path))?;
+        let channels = add_channels(&mut writer, path)?;
+        write_metadata(&mut writer, path, scene_text, model)?;
+        Ok(Recorder {
+            writer: Some(writer),
+            path: path.into(),
+            channels,
+            count: 0,
+            sequence: 0,
+            rod_diameter,
+            model: model.clone(),
+        })
+    }
+
+    /// `value` as JSON bytes.
+    fn json<T: serde::Serialize + ?Sized>(&self, step: &'static str, value: &T) -> Result<Vec<u8>> {
+        serde_json::to_vec(value).map_err(IoError::json(step, &self.path))
+    }
+
+    /// Where it is written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    fn write(&mut self, channel: usize, log_time: u64, data: &[u8]) -> Result<()> {
+        let w = self.writer.as_mut().ok_or_else(|| IoError::Recording {
+            path: self.path.clone(),
+            reason: "recording already finished".into(),
+        })?;
+        self.sequence += 1;
+        w.write_to_known_channel(
+            &MessageHeader {
+                channel_id: self.channels[channel],
+                sequence: self.sequence,
+                log_time,
+                publish_time: log_time,
+            },
+            data,
+        )
+        .map_err(mcap_error("writing a message", &self.path))
+    }
+
+    /// Record one equilibrium (log time = its index, in seconds).
+    pub fn record(&mut self, e: &Equilibrium) -> Result<()> {
+        let index = self.count;
+        let t = index * 1_000_000_000;
+        let stamp = Some(Timestamp::new(index as u32, 0));
+        self.write(
+            0,
+            t,
+            &encode(&scene_update(e, self.rod_diameter, stamp), &self.path)?,
+        )?;
+        let tf = FrameTransform {
+            timestamp: stamp,
+            parent_frame_id: "world".into(),
+            child_frame_id: "rod".into(),
+            translation: Some(FgVector3 {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+            }),
+            rotation: Some(Quaternion {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+                w: 1.0,
+            }),
+        };
+        self.write(1, t, &encode(&tf, &self.path)?)?;
+        let scalars = self.json("encoding the scalars", &Scalars::of(index, e))?;
+        self.write(2, t, &scalars)?;
+        let state = StateMessage {
+            index,
+            model: self.model.clone(),
+            state: e.state.clone(),
+        };
+        let state = self.json("encoding the state", &state)?;
+        self.write(3, t, &state)?;
+        self.count += 1;
+        Ok(())
+    }
+
+    /// Record the located events (at the time of the last state).
+    pub fn events(&mut self, events: &[Event]) -> Result<()> {
+        let t = self.count.saturating_sub(1) * 1_000_000_000;
+        for e in events {
+            let event = self.json("encoding an event", e)?;
+            self.write(4, t, &event)?;
+        }
+        Ok(())
+    }
+
+    /// Number of states recorded.
+    pub fn len(&self) -> u64 {
+        self.count
+    }
+
+    /// No state recorded yet.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Write the summary and close the file.
+    pub fn finish(mut self) -> Result<()> {
+        if let Some(mut w) = self.writer.take() {
+            w.finish().map_err(mcap_error("finalising", &self.path))?;
+        }
+        Ok(())
+    }
+}
