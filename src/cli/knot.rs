@@ -1,6 +1,5 @@
 //! `knotrod knot`: writhe and knot type of any curve.
 
-use super::RayKind;
 use crate::geometry::closure::{extent, ray_closure};
 use crate::geometry::knot::{KnotType, knot_type};
 use crate::geometry::writhe::writhe_closed;
@@ -10,6 +9,15 @@ use anyhow::Result;
 use nalgebra::Vector3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+
+/// Directions of the closing rays of an open curve.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum RayKind {
+    /// Along the end tangents.
+    Tangent,
+    /// Along −z from the first point and +z from the last.
+    Z,
+}
 
 /// Writhe and knot type of a curve file, printed or as JSON.
 pub fn knot(path: &Path, closed: bool, rays: RayKind, json: Option<PathBuf>) -> Result<()> {

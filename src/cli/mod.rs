@@ -10,6 +10,7 @@ mod run;
 use crate::io::export::ExportFormat;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+pub use knot::RayKind;
 use std::path::PathBuf;
 
 /// knotrod: equilibria and stability of clamped elastic rods.
@@ -128,15 +129,6 @@ pub enum Command {
         #[arg(long, value_delimiter = ',', default_value = "50,100,200,400,800")]
         segments: Vec<usize>,
     },
-}
-
-/// Directions of the closing rays of an open curve.
-#[derive(clap::ValueEnum, Clone, Copy, Debug)]
-pub enum RayKind {
-    /// Along the end tangents.
-    Tangent,
-    /// Along −z from the first point and +z from the last.
-    Z,
 }
 
 /// Run the command line.

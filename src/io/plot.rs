@@ -69,25 +69,6 @@ impl From<&Equilibrium> for PlotPoint {
     }
 }
 
-impl From<&crate::io::recording::Scalars> for PlotPoint {
-    fn from(e: &crate::io::recording::Scalars) -> Self {
-        PlotPoint {
-            phi_over_2pi: e.phi_over_2pi,
-            twist: e.twist,
-            stable: e.stable,
-            colour: colour_of(Class::of(
-                e.stable,
-                is_trefoil(e.knot_determinant),
-                e.good_knot,
-            )),
-            omega_squared: Some(e.lowest_omega_squared).filter(|v| v.is_finite()),
-            min_self_distance: e.min_self_distance,
-            branch: e.branch,
-            leg: e.leg,
-        }
-    }
-}
-
 /// Polylines of the branches: (branch, leg) runs, each leg after the first
 /// starting from its branch's first point.
 fn legs(eqs: &[PlotPoint]) -> Vec<Vec<&PlotPoint>> {

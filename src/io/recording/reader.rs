@@ -1,6 +1,6 @@
 //! Reading a recording back: its scalars, events and metadata, or one state.
 
-use super::{EVENTS_TOPIC, SCALARS_TOPIC, STATE_TOPIC, Scalars, StateMessage};
+use super::messages::{EVENTS_TOPIC, SCALARS_TOPIC, STATE_TOPIC, Scalars, StateMessage};
 use crate::analysis::event::Event;
 use crate::io::error::{IoError, Result};
 use std::collections::BTreeMap;

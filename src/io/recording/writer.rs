@@ -1,7 +1,7 @@
 //! Writing a recording: [`Recorder`].
 
 use super::foxglove::scene_update;
-use super::{
+use super::messages::{
     EVENT_SCHEMA, EVENTS_TOPIC, SCALARS_SCHEMA, SCALARS_TOPIC, SCENE_TOPIC, STATE_SCHEMA,
     STATE_TOPIC, Scalars, StateMessage, TF_TOPIC,
 };
