@@ -275,16 +275,22 @@ fn damaged_recordings_give_clear_errors() {
     let garbage = dir.join("garbage.mcap");
     std::fs::write(&garbage, b"this is not an mcap file at all").unwrap();
     for bad in [&cut, &garbage] {
-        let e = read_recording(bad)
-            .expect_err("damaged recording rejected")
-            .to_string();
-        assert!(e.contains("not a readable MCAP recording"), "{e}");
+        let e = read_recording(bad).expect_err("damaged recording rejected");
+        assert!(
+            matches!(&e, knotrod::io::IoError::Recording { path, .. } if path == bad),
+            "{e}"
+        );
+        assert!(
+            e.to_string().contains("not a readable MCAP recording"),
+            "{e}"
+        );
         let out = knotrod(&["info", bad.to_str().unwrap()]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success() && !err.contains("panicked"), "{err}");
     }
-    let e = read_state(&rec, 10_000).err().unwrap().to_string();
-    assert!(e.contains("no state with index 10000"), "{e}");
+    let e = read_state(&rec, 10_000).err().unwrap();
+    assert!(matches!(e, knotrod::io::IoError::Recording { .. }), "{e}");
+    assert!(e.to_string().contains("no state with index 10000"), "{e}");
 }
 
 #[test]

@@ -6,7 +6,7 @@ use crate::analysis::equilibrium::{Conformation, Equilibrium, analyse};
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting};
-use crate::scene::{InitialShape, InitialSpec, Scene};
+use crate::scene::{InitialShape, InitialSpec, Scene, SceneError};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
 use crate::study::error::{Context, Result, fail};
@@ -69,14 +69,16 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
             set(&mut state, 0.0);
             let shape = Conformation::of(&state, &scene.measure());
             if !is_trefoil(shape.knot.determinant) {
-                fail!(
-                    "initial.shape = \"trefoil\": at z* = {}, δ = {} the guide curve's ray \
-                     closure is not a trefoil (knot determinant {}); start from the \
-                     paper's clamps (z* ≈ 0.115, δ ≈ 0.05) and load from there",
-                    clamps.z_star,
-                    clamps.delta,
-                    shape.knot.determinant
-                );
+                return Err(SceneError::Invalid {
+                    field: "initial.shape",
+                    reason: format!(
+                        "\"trefoil\": at z* = {}, δ = {} the guide curve's ray closure is \
+                         not a trefoil (knot determinant {}); start from the paper's clamps \
+                         (z* ≈ 0.115, δ ≈ 0.05) and load from there",
+                        clamps.z_star, clamps.delta, shape.knot.determinant
+                    ),
+                }
+                .into());
             }
             let turns = (target - state.twist() - shape.writhe).round();
             set(&mut state, turns);
