@@ -153,160 +153,349 @@ pub fn minimize(
     state: &mut RodState,
     settings: &SolverSettings,
 ) -> Result<SolveReport, SolveError> {
-    let map = energy.map;
-    let n = map.len();
-    let h = energy.model.segment_length();
-    let constrained = energy.penalty.is_some();
-    let penalty = energy.penalty.unwrap_or(0.0);
-    let segments = energy.model.segments;
-    if constrained {
-        state.multipliers.resize(segments + 1, 0.0);
-    }
-    let m_eq = if constrained { segments } else { 0 };
-    let nnz = energy.pattern.nnz();
-    let mut grad = vec![0.0; n];
-    let mut values = vec![0.0; nnz];
-    let mut jtc = vec![0.0; n];
-    let mut jtl = vec![0.0; n];
-    // per-iteration work vectors, allocated once
-    let mut lagrangian = vec![0.0; n];
-    let mut q = vec![0.0; n];
-    let mut residual_kkt = vec![0.0; n + m_eq];
-    let mut trial_step = vec![0.0; n];
-    let mut part = vec![0.0; n];
-    let mut sub = state.clone();
-    let mut jacobian = ConstraintMatrix::new(energy);
-    let mut kkt = constrained.then(|| Kkt::new(&energy));
-    let step_cap = match &contact {
-        Some(c) => settings.max_step.min(0.5 * c.margin),
-        None => settings.max_step,
-    };
-    let mut solver: Option<DefaultSolver<f64>> = None;
-    // the widened Hessian of the last contact set (pattern and symbolic
-    // factorisation reused while the set is unchanged)
-    let mut wide: Option<ContactHessian> = None;
-    let mut report = SolveReport::start();
-    let mut trial = state.clone();
-    let mut shift;
-    // contact forces of the last QP, by (segments, obstacle kind)
-    let mut forces: Vec<(Gap, f64)> = Vec::new();
+    let mut sqp = Sqp::new(energy, ldlt, contact, state, settings);
     for it in 0..=settings.max_iterations {
-        let info = energy.hessian(state, &mut grad, &mut values);
-        let rows = if constrained {
-            energy.constraint_rows(state)
-        } else {
-            Vec::new()
-        };
-        let c: Vec<f64> = rows.iter().map(|r| r.0).collect();
-        jacobian.fill(&rows);
-        let (gaps, gap_rows) = contact_rows(energy, contact, state);
-        // Lagrangian gradient ∇E + Jᵀλ − Σ z ∇g = ∇(augmented) − ρ Jᵀc − Σ z ∇g
-        lagrangian.copy_from_slice(&grad);
+        sqp.linearise(it)?;
+        if sqp.converged() {
+            return Ok(sqp.converged_report());
+        }
+        if it == settings.max_iterations {
+            break;
+        }
+        sqp.assemble_hessian();
+        sqp.convexify(it)?;
+        sqp.solve_subproblem(it)?;
+        sqp.polish_equality_step();
+        sqp.polish_contact_step();
+        sqp.exact_contact_step();
+        sqp.update_forces();
+        sqp.cap_step();
+        let alpha = sqp.line_search(it)?;
+        sqp.extend_step(alpha);
+        sqp.accept();
+    }
+    Err(sqp.report.not_converged())
+}
+
+/// The QP's Hessian: the energy's (values from the linearisation), or with
+/// contacts near the one widened by the contact couplings; either is shifted
+/// in place by `convexify` and factored into its own `Ldlt`.
+struct QpHessian<'a> {
+    /// The energy Hessian's pattern.
+    pattern: &'a SymmetricPattern,
+    /// The energy Hessian's values.
+    values: Vec<f64>,
+    /// The energy Hessian's factorisation.
+    ldlt: &'a mut Ldlt,
+    /// The widened Hessian of the last contact set (pattern and symbolic
+    /// factorisation reused while the set is unchanged).
+    wide: Option<ContactHessian>,
+    /// This iteration's QP uses `wide`.
+    widened: bool,
+}
+
+impl QpHessian<'_> {
+    /// The pattern, values and factorisation of this iteration's QP Hessian.
+    fn parts(&mut self) -> (&SymmetricPattern, &mut [f64], &mut Ldlt) {
+        match self.wide.as_mut() {
+            Some(w) if self.widened => (&w.pattern, &mut w.values, &mut w.ldlt),
+            _ => (self.pattern, &mut self.values, &mut *self.ldlt),
+        }
+    }
+}
+
+/// The residuals of the iterate.
+#[derive(Default)]
+struct Residuals {
+    /// Largest |diagonal| of the energy Hessian.
+    max_diag: f64,
+    /// Relative Lagrangian gradient, and whether it is at its round-off floor.
+    rel: f64,
+    at_floor: bool,
+    /// Largest |u2|, and largest penetration.
+    infeasibility: f64,
+    penetration: f64,
+}
+
+/// One SQP solve: the problem, the work data (allocated once), the current
+/// iterate's linearisation and its step. The iteration is a sequence of
+/// phases, each a method (after Clarabel's solver loop).
+struct Sqp<'a> {
+    energy: &'a RodEnergy,
+    contact: Option<&'a ContactModel>,
+    settings: &'a SolverSettings,
+    state: &'a mut RodState,
+    report: SolveReport,
+    // the problem's sizes
+    /// Free dofs.
+    n: usize,
+    /// Segment length.
+    h: f64,
+    /// The law is constrained (u2 = 0 rows, penalty ρ).
+    constrained: bool,
+    penalty: f64,
+    /// Number of equality rows.
+    m_eq: usize,
+    /// Largest translation of one step.
+    step_cap: f64,
+    // the linearisation at the iterate
+    /// Energy gradient (in the line search: the merit's).
+    grad: Vec<f64>,
+    /// Equality rows: values c and gradients (vertex stencils).
+    rows: Vec<(f64, [f64; 11])>,
+    c: Vec<f64>,
+    jacobian: ConstraintMatrix,
+    jtc: Vec<f64>,
+    /// Candidate contacts and their gradients.
+    gaps: Vec<Gap>,
+    gap_rows: Vec<Vec<(usize, f64)>>,
+    lagrangian: Vec<f64>,
+    res: Residuals,
+    // the QP
+    hessian: QpHessian<'a>,
+    /// Diagonal shift that convexifies the QP Hessian.
+    shift: f64,
+    /// The QP's linear term.
+    q: Vec<f64>,
+    jtl: Vec<f64>,
+    solver: Option<DefaultSolver<f64>>,
+    kkt: Option<Kkt>,
+    residual_kkt: Vec<f64>,
+    // the step
+    /// The step d, then capped.
+    step: Vec<f64>,
+    /// New multipliers of the equality rows, and contact forces, of the QP.
+    lambda: Vec<f64>,
+    z: Vec<f64>,
+    /// Contact forces of the last QP, by (segments, obstacle kind).
+    forces: Vec<(Gap, f64)>,
+    /// Largest translation of the uncapped step.
+    largest: f64,
+    /// Exact penalty weight of the contact gaps in the merit.
+    mu: f64,
+    // the line search
+    trial_step: Vec<f64>,
+    /// Scratch: a sub-step, or a Hessian product.
+    part: Vec<f64>,
+    trial: RodState,
+    sub: RodState,
+}
+
+impl<'a> Sqp<'a> {
+    fn new(
+        energy: &'a RodEnergy,
+        ldlt: &'a mut Ldlt,
+        contact: Option<&'a ContactModel>,
+        state: &'a mut RodState,
+        settings: &'a SolverSettings,
+    ) -> Self {
+        let n = energy.map.len();
+        let constrained = energy.penalty.is_some();
+        let segments = energy.model.segments;
         if constrained {
-            jacobian.transpose_mul(&c, &mut jtc);
-            lagrangian
-                .iter_mut()
-                .zip(&jtc)
-                .for_each(|(l, j)| *l -= penalty * j);
+            state.multipliers.resize(segments + 1, 0.0);
         }
-        for (g, z) in &forces {
-            if let Some(k) = gaps.iter().position(|x| same_pair(x, g)) {
-                for &(d, v) in &gap_rows[k] {
-                    lagrangian[d] -= z * v;
-                }
-            }
+        let m_eq = if constrained { segments } else { 0 };
+        let step_cap = match &contact {
+            Some(c) => settings.max_step.min(0.5 * c.margin),
+            None => settings.max_step,
+        };
+        let sub = state.clone();
+        let trial = state.clone();
+        let hessian = QpHessian {
+            pattern: &energy.pattern,
+            values: vec![0.0; energy.pattern.nnz()],
+            ldlt,
+            wide: None,
+            widened: false,
+        };
+        Sqp {
+            energy,
+            contact,
+            settings,
+            state,
+            report: SolveReport::start(),
+            n,
+            h: energy.model.segment_length(),
+            constrained,
+            penalty: energy.penalty.unwrap_or(0.0),
+            m_eq,
+            step_cap,
+            grad: vec![0.0; n],
+            rows: Vec::new(),
+            c: Vec::new(),
+            jacobian: ConstraintMatrix::new(energy),
+            jtc: vec![0.0; n],
+            gaps: Vec::new(),
+            gap_rows: Vec::new(),
+            lagrangian: vec![0.0; n],
+            res: Residuals::default(),
+            hessian,
+            shift: 0.0,
+            q: vec![0.0; n],
+            jtl: vec![0.0; n],
+            solver: None,
+            kkt: constrained.then(|| Kkt::new(energy)),
+            residual_kkt: vec![0.0; n + m_eq],
+            step: Vec::new(),
+            lambda: Vec::new(),
+            z: Vec::new(),
+            forces: Vec::new(),
+            largest: 0.0,
+            mu: 0.0,
+            trial_step: vec![0.0; n],
+            part: vec![0.0; n],
+            trial,
+            sub,
         }
-        let gnorm = lagrangian.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let max_diag = energy.pattern.max_abs_diagonal(&values);
-        let (rel, at_floor) = residual(&info, gnorm, max_diag, state, n);
-        let infeasibility = c.iter().map(|x| (x / h).abs()).fold(0.0, f64::max);
-        let penetration = gaps.iter().map(|g| -g.gap).fold(0.0, f64::max);
-        if !rel.is_finite() || !infeasibility.is_finite() {
+    }
+
+    /// Energy Hessian, equality and contact rows, Lagrangian gradient and
+    /// the residuals of the iterate (recorded in the report).
+    fn linearise(&mut self, it: usize) -> Result<(), SolveError> {
+        let energy = self.energy;
+        let info = energy.hessian(self.state, &mut self.grad, &mut self.hessian.values);
+        if self.constrained {
+            energy.constraint_rows_into(self.state, &mut self.rows);
+        }
+        self.c.clear();
+        self.c.extend(self.rows.iter().map(|r| r.0));
+        self.jacobian.fill(&self.rows);
+        (self.gaps, self.gap_rows) = contact_rows(energy, self.contact, self.state);
+        self.lagrangian_gradient();
+        let gnorm = self.lagrangian.iter().map(|x| x * x).sum::<f64>().sqrt();
+        self.res.max_diag = energy.pattern.max_abs_diagonal(&self.hessian.values);
+        (self.res.rel, self.res.at_floor) =
+            residual(&info, gnorm, self.res.max_diag, self.state, self.n);
+        let h = self.h;
+        self.res.infeasibility = self.c.iter().map(|x| (x / h).abs()).fold(0.0, f64::max);
+        self.res.penetration = self.gaps.iter().map(|g| -g.gap).fold(0.0, f64::max);
+        if !self.res.rel.is_finite() || !self.res.infeasibility.is_finite() {
             return Err(SolveError::NonFinite {
                 step: "constrained gradient",
                 iteration: it,
             });
         }
-        report.record(it, rel.max(infeasibility), info.energy);
-        let contact_ok = contact
-            .as_ref()
-            .is_none_or(|m| penetration <= 1e-6 * m.diameter);
+        self.report
+            .record(it, self.res.rel.max(self.res.infeasibility), info.energy);
+        Ok(())
+    }
+
+    /// Lagrangian gradient ∇E + Jᵀλ − Σ z ∇g = ∇(augmented) − ρ Jᵀc − Σ z ∇g
+    /// (forces of the last QP).
+    fn lagrangian_gradient(&mut self) {
+        self.lagrangian.copy_from_slice(&self.grad);
+        if self.constrained {
+            self.jacobian.transpose_mul(&self.c, &mut self.jtc);
+            let penalty = self.penalty;
+            self.lagrangian
+                .iter_mut()
+                .zip(&self.jtc)
+                .for_each(|(l, j)| *l -= penalty * j);
+        }
+        for (g, z) in &self.forces {
+            if let Some(k) = self.gaps.iter().position(|x| same_pair(x, g)) {
+                for &(d, v) in &self.gap_rows[k] {
+                    self.lagrangian[d] -= z * v;
+                }
+            }
+        }
+    }
+
+    /// The iterate is a KKT point: small residual, feasible, no penetration.
+    fn converged(&self) -> bool {
+        let contact_ok = self
+            .contact
+            .is_none_or(|m| self.res.penetration <= 1e-6 * m.diameter);
         // with contacts the KKT residual stalls near 1e-8: the closest points
         // of a rod lying along an obstacle are not smooth functions of the
         // nodes (and the interior-point duals carry that accuracy)
-        let tol = if forces.iter().any(|f| f.1 > 0.0) {
-            settings.gradient_tol.max(CONTACT_TOL)
+        let tol = if self.forces.iter().any(|f| f.1 > 0.0) {
+            self.settings.gradient_tol.max(CONTACT_TOL)
         } else {
-            settings.gradient_tol
+            self.settings.gradient_tol
         };
-        if (rel <= tol || at_floor) && infeasibility <= CURVATURE_TOL && contact_ok {
-            report.converged = true;
-            let rows: Vec<ContactForce> = forces
-                .iter()
-                .filter(|(_, z)| *z > 0.0)
-                .filter_map(|(g, z)| {
-                    let now = gaps.iter().find(|x| same_pair(x, g))?;
-                    Some(ContactForce {
-                        s: now.s,
-                        obstacle: now.obstacle.name(),
-                        force: *z,
-                        gap: now.gap,
-                    })
+        (self.res.rel <= tol || self.res.at_floor)
+            && self.res.infeasibility <= CURVATURE_TOL
+            && contact_ok
+    }
+
+    /// The report of a converged solve, with its contacts.
+    fn converged_report(mut self) -> SolveReport {
+        self.report.converged = true;
+        let gaps = &self.gaps;
+        let rows: Vec<ContactForce> = self
+            .forces
+            .iter()
+            .filter(|(_, z)| *z > 0.0)
+            .filter_map(|(g, z)| {
+                let now = gaps.iter().find(|x| same_pair(x, g))?;
+                Some(ContactForce {
+                    s: now.s,
+                    obstacle: now.obstacle.name(),
+                    force: *z,
+                    gap: now.gap,
                 })
-                .collect();
-            report.contacts = merge_contacts(rows, 1.5 * h);
-            report.contact_rows = forces
-                .iter()
-                .filter(|(_, z)| *z > 0.0)
-                .filter_map(|(g, z)| Some((gaps.iter().find(|x| same_pair(x, g))?.clone(), *z)))
-                .collect();
-            return Ok(report);
-        }
-        if it == settings.max_iterations {
-            break;
-        }
-        // with contacts the QP's Hessian is that of the Lagrangian E − Σ z g
-        // (the contacts' curvature, forces from the last QP), on the energy's
-        // pattern widened by the contact couplings
-        let widened = match &contact {
-            Some(model) if !gaps.is_empty() => {
-                let refs: Vec<&Gap> = gaps.iter().collect();
-                if !wide.as_ref().is_some_and(|w| w.fits(&refs)) {
-                    wide = Some(ContactHessian::new(&energy, &refs));
+            })
+            .collect();
+        self.report.contacts = merge_contacts(rows, 1.5 * self.h);
+        self.report.contact_rows = self
+            .forces
+            .iter()
+            .filter(|(_, z)| *z > 0.0)
+            .filter_map(|(g, z)| Some((gaps.iter().find(|x| same_pair(x, g))?.clone(), *z)))
+            .collect();
+        self.report
+    }
+
+    /// The QP Hessian. With contacts it is that of the Lagrangian E − Σ z g
+    /// (the contacts' curvature, forces from the last QP), on the energy's
+    /// pattern widened by the contact couplings.
+    fn assemble_hessian(&mut self) {
+        let hessian = &mut self.hessian;
+        hessian.widened = match self.contact {
+            Some(model) if !self.gaps.is_empty() => {
+                let refs: Vec<&Gap> = self.gaps.iter().collect();
+                if !hessian.wide.as_ref().is_some_and(|w| w.fits(&refs)) {
+                    hessian.wide = Some(ContactHessian::new(self.energy, &refs));
                 }
+                let forces = &self.forces;
                 let z = |g: &Gap| {
                     forces
                         .iter()
                         .find(|f| same_pair(&f.0, g))
                         .map_or(0.0, |f| f.1)
                 };
-                let w = wide.as_mut().expect("built above");
+                let w = hessian.wide.as_mut().expect("built above");
                 w.fill(
-                    &energy,
-                    &values,
+                    self.energy,
+                    &hessian.values,
                     model,
-                    state,
-                    gaps.iter().map(|g| (g, z(g))),
+                    self.state,
+                    self.gaps.iter().map(|g| (g, z(g))),
                     0.0,
                 );
                 true
             }
             _ => false,
         };
-        let (pat, vals, ldlt): (&SymmetricPattern, &mut Vec<f64>, &mut Ldlt) = match wide.as_mut() {
-            Some(w) if widened => (&w.pattern, &mut w.values, &mut w.ldlt),
-            _ => (&energy.pattern, &mut values, ldlt),
-        };
-        // convexify: W + shift I positive definite, the shift just beyond the
-        // lowest eigenvalue (a larger one would make a falling rod creep)
-        shift = 0.0;
+    }
+
+    /// Convexify: W + shift I positive definite (and factored), the shift
+    /// just beyond the lowest eigenvalue (a larger one would make a falling
+    /// rod creep).
+    fn convexify(&mut self, it: usize) -> Result<(), SolveError> {
+        let max_diag = self.res.max_diag;
+        let (pat, vals, ldlt) = self.hessian.parts();
+        let mut shift = 0.0;
         loop {
             for &s in &pat.diagonal {
                 vals[s] += shift;
             }
-            report.factorizations += 1;
+            self.report.factorizations += 1;
             if ldlt.factor(vals).is_ok() && ldlt.negative_count() == 0 {
-                break;
+                self.shift = shift;
+                return Ok(());
             }
             for &s in &pat.diagonal {
                 vals[s] -= shift;
@@ -327,204 +516,287 @@ pub fn minimize(
                 });
             }
         }
+    }
+
+    /// The step: the QP's (clarabel) with its multipliers and contact forces,
+    /// or with nothing to constrain the (shifted) Newton step.
+    fn solve_subproblem(&mut self, it: usize) -> Result<(), SolveError> {
         // QP: linear term ∇E + ρ Jᵀc = ∇(augmented) − Jᵀλ
-        q.copy_from_slice(&grad);
-        if constrained {
-            jacobian.transpose_mul(&state.multipliers[1..], &mut jtl);
-            q.iter_mut().zip(&jtl).for_each(|(g, j)| *g -= j);
+        self.q.copy_from_slice(&self.grad);
+        if self.constrained {
+            self.jacobian
+                .transpose_mul(&self.state.multipliers[1..], &mut self.jtl);
+            self.q.iter_mut().zip(&self.jtl).for_each(|(g, j)| *g -= j);
         }
-        let (mut d, mut new_lambda, z) = if m_eq == 0 && gaps.is_empty() {
-            // nothing to constrain here: the (shifted) Newton step
-            let mut d: Vec<f64> = q.iter().map(|x| -x).collect();
-            ldlt.solve_in_place(&mut d);
-            (d, Vec::new(), Vec::new())
-        } else {
-            let (a, b) = stack_rows(&jacobian.matrix, &c, &gap_rows, &gaps, n);
-            if !gaps.is_empty() {
-                // the contact rows change from step to step
-                solver = None;
-            }
-            let (d, duals) = solve_qp(
-                &mut solver,
-                (pat.matrix.col_offsets(), pat.matrix.row_indices(), vals),
-                &q,
-                &a,
-                &b,
-                m_eq,
-            )
-            .ok_or(SolveError::NonFinite {
-                step: "SQP subproblem (clarabel)",
-                iteration: it,
-            })?;
-            let (l, z) = duals.split_at(m_eq);
-            (d, l.to_vec(), z.to_vec())
+        let (pat, vals, ldlt) = self.hessian.parts();
+        if self.m_eq == 0 && self.gaps.is_empty() {
+            self.step = self.q.iter().map(|x| -x).collect();
+            ldlt.solve_in_place(&mut self.step);
+            self.lambda = Vec::new();
+            self.z = Vec::new();
+            return Ok(());
+        }
+        let (a, b) = stack_rows(
+            &self.jacobian.matrix,
+            &self.c,
+            &self.gap_rows,
+            &self.gaps,
+            self.n,
+        );
+        if !self.gaps.is_empty() {
+            // the contact rows change from step to step
+            self.solver = None;
+        }
+        let (d, duals) = solve_qp(
+            &mut self.solver,
+            (pat.matrix.col_offsets(), pat.matrix.row_indices(), vals),
+            &self.q,
+            &a,
+            &b,
+            self.m_eq,
+        )
+        .ok_or(SolveError::NonFinite {
+            step: "SQP subproblem (clarabel)",
+            iteration: it,
+        })?;
+        let (l, z) = duals.split_at(self.m_eq);
+        self.step = d;
+        self.lambda = l.to_vec();
+        self.z = z.to_vec();
+        Ok(())
+    }
+
+    /// Polish (equality rows only): Newton on the QP's KKT conditions with
+    /// the exact sparse KKT factorisation.
+    fn polish_equality_step(&mut self) {
+        let Some(kkt) = self.kkt.as_mut().filter(|_| self.gaps.is_empty()) else {
+            return;
         };
-        // polish (equality rows only): Newton on the QP's KKT conditions with
-        // the exact sparse KKT factorisation
-        if let Some(kkt) = kkt.as_mut().filter(|_| gaps.is_empty()) {
-            kkt.assemble(vals, &rows);
-            if kkt.ldlt.factor(&kkt.values).is_ok() {
-                report.factorizations += 1;
-                for _ in 0..2 {
-                    let r = &mut residual_kkt;
-                    pat.mul_vec(vals, &d, &mut r[..n]);
-                    jacobian.transpose_mul(&new_lambda, &mut jtl);
-                    for k in 0..n {
-                        r[k] = -(r[k] + q[k] + jtl[k]);
-                    }
-                    jacobian.mul(&d, &mut r[n..]);
-                    for (rc, ck) in r[n..].iter_mut().zip(&c) {
-                        *rc = -(*rc + ck);
-                    }
-                    kkt.ldlt.solve_in_place(r);
-                    d.iter_mut().zip(&r[..n]).for_each(|(x, y)| *x += y);
-                    new_lambda
-                        .iter_mut()
-                        .zip(&r[n..])
-                        .for_each(|(x, y)| *x += y);
-                }
+        let (pat, vals, _) = self.hessian.parts();
+        kkt.assemble(vals, &self.rows);
+        if kkt.ldlt.factor(&kkt.values).is_err() {
+            return;
+        }
+        self.report.factorizations += 1;
+        let n = self.n;
+        for _ in 0..2 {
+            let r = &mut self.residual_kkt;
+            pat.mul_vec(vals, &self.step, &mut r[..n]);
+            self.jacobian.transpose_mul(&self.lambda, &mut self.jtl);
+            for ((rk, qk), jk) in r[..n].iter_mut().zip(&self.q).zip(&self.jtl) {
+                *rk = -(*rk + qk + jk);
+            }
+            self.jacobian.mul(&self.step, &mut r[n..]);
+            for (rc, ck) in r[n..].iter_mut().zip(&self.c) {
+                *rc = -(*rc + ck);
+            }
+            kkt.ldlt.solve_in_place(r);
+            self.step.iter_mut().zip(&r[..n]).for_each(|(x, y)| *x += y);
+            self.lambda
+                .iter_mut()
+                .zip(&r[n..])
+                .for_each(|(x, y)| *x += y);
+        }
+    }
+
+    /// Polish (contacts, no equality rows): the exact QP solution by an
+    /// active-set iteration from the interior point's duals.
+    fn polish_contact_step(&mut self) {
+        if self.m_eq != 0 || self.gaps.is_empty() {
+            return;
+        }
+        let (pat, vals, ldlt) = self.hessian.parts();
+        let Some((dp, zp)) =
+            polish_contacts(ldlt, &self.q, &self.gap_rows, &self.gaps, &self.z, None)
+        else {
+            return;
+        };
+        // keep the polish unless the interior point's step is feasible
+        // and better (an inexact interior point can miss the active set,
+        // or stop outside the linearised constraints)
+        let (q, part) = (&self.q, &mut self.part);
+        let mut objective = |x: &[f64]| {
+            pat.mul_vec(vals, x, part);
+            0.5 * x.iter().zip(part.iter()).map(|(a, b)| a * b).sum::<f64>()
+                + x.iter().zip(q).map(|(a, b)| a * b).sum::<f64>()
+        };
+        let (h, d) = (self.h, &self.step);
+        let feasible = self
+            .gaps
+            .iter()
+            .zip(&self.gap_rows)
+            .all(|(g, r)| g.gap + r.iter().map(|&(k, v)| v * d[k]).sum::<f64>() >= -1e-9 * h);
+        if !feasible || objective(&dp) <= objective(d) + 1e-12 * objective(d).abs() {
+            self.step = dp;
+            self.z = zp;
+        }
+    }
+
+    /// The convexified QP converges only linearly; where the true Hessian
+    /// is positive definite on the active contacts' tangent space, the
+    /// exact SQP step (same active set, unshifted Hessian) restores
+    /// Newton's quadratic convergence.
+    fn exact_contact_step(&mut self) {
+        if !(self.m_eq == 0 && self.shift > 0.0 && self.z.iter().any(|v| *v > 0.0)) {
+            return;
+        }
+        self.report.factorizations += 1;
+        let (pat, vals, ldlt) = self.hessian.parts();
+        for &s in &pat.diagonal {
+            vals[s] -= self.shift;
+        }
+        if ldlt.factor(vals).is_ok() {
+            let k = ldlt.negative_count();
+            if let Some((dp, zp)) =
+                polish_contacts(ldlt, &self.q, &self.gap_rows, &self.gaps, &self.z, Some(k))
+            {
+                self.step = dp;
+                self.z = zp;
             }
         }
-        // polish (contacts, no equality rows): the exact QP solution by an
-        // active-set iteration from the interior point's duals
-        let mut z = z;
-        if m_eq == 0
-            && !gaps.is_empty()
-            && let Some((dp, zp)) = polish_contacts(ldlt, &q, &gap_rows, &gaps, &z, None)
-        {
-            // keep the polish unless the interior point's step is feasible
-            // and better (an inexact interior point can miss the active set,
-            // or stop outside the linearised constraints)
-            let mut objective = |x: &[f64]| {
-                pat.mul_vec(vals, x, &mut part);
-                0.5 * x.iter().zip(&part).map(|(a, b)| a * b).sum::<f64>()
-                    + x.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>()
-            };
-            let feasible = gaps
-                .iter()
-                .zip(&gap_rows)
-                .all(|(g, r)| g.gap + r.iter().map(|&(k, v)| v * d[k]).sum::<f64>() >= -1e-9 * h);
-            if !feasible || objective(&dp) <= objective(&d) + 1e-12 * objective(&d).abs() {
-                d = dp;
-                z = zp;
-            }
-        }
-        // the convexified QP converges only linearly; where the true Hessian
-        // is positive definite on the active contacts' tangent space, the
-        // exact SQP step (same active set, unshifted Hessian) restores
-        // Newton's quadratic convergence
-        if m_eq == 0 && shift > 0.0 && z.iter().any(|v| *v > 0.0) {
-            report.factorizations += 1;
-            for &s in &pat.diagonal {
-                vals[s] -= shift;
-            }
-            if ldlt.factor(vals).is_ok() {
-                let k = ldlt.negative_count();
-                if let Some((dp, zp)) = polish_contacts(ldlt, &q, &gap_rows, &gaps, &z, Some(k)) {
-                    d = dp;
-                    z = zp;
-                }
-            }
-        }
-        forces = gaps
+    }
+
+    /// The contact forces of this QP (for the next Lagrangian).
+    fn update_forces(&mut self) {
+        self.forces = self
+            .gaps
             .iter()
             .cloned()
-            .zip(z.iter().map(|v| v.max(0.0)))
+            .zip(self.z.iter().map(|v| v.max(0.0)))
             .collect();
-        let mut step = d;
-        let largest = (0..n)
+    }
+
+    /// Scale the step down to the step cap (on its largest translation).
+    fn cap_step(&mut self) {
+        let map = &self.energy.map;
+        let step = &self.step;
+        self.largest = (0..self.n)
             .filter(|&k| map.is_translation(k))
             .map(|k| step[k].abs())
             .fold(0.0, f64::max);
-        if largest > step_cap {
-            let f = step_cap / largest;
-            step.iter_mut().for_each(|v| *v *= f);
+        if self.largest > self.step_cap {
+            let f = self.step_cap / self.largest;
+            self.step.iter_mut().for_each(|v| *v *= f);
         }
-        // merit: the augmented Lagrangian with the new multipliers, plus an
-        // exact penalty on the contact gaps
-        if constrained {
-            state.multipliers[1..].copy_from_slice(&new_lambda);
+    }
+
+    /// Armijo search on the merit: the augmented Lagrangian with the new
+    /// multipliers, plus an exact penalty on the contact gaps. Returns the
+    /// accepted step length (the trial state is at it).
+    fn line_search(&mut self, it: usize) -> Result<f64, SolveError> {
+        if self.constrained {
+            self.state.multipliers[1..].copy_from_slice(&self.lambda);
         }
-        let mu = 2.0 * z.iter().fold(0.0f64, |a, b| a.max(*b)) + 1.0;
-        let contact_penalty = |s: &RodState| -> f64 {
-            match &contact {
-                Some(m) if !gaps.is_empty() => {
-                    let (points, _) = s.centreline();
-                    gaps.iter()
-                        .map(|g| (-m.gap_at(&points, g)).max(0.0))
-                        .sum::<f64>()
-                        * mu
-                }
-                _ => 0.0,
-            }
+        self.mu = 2.0 * self.z.iter().fold(0.0f64, |a, b| a.max(*b)) + 1.0;
+        let merit_info = self.energy.gradient(self.state, &mut self.grad);
+        let merit0 = merit_info.energy + self.contact_penalty(self.state);
+        let violation = self.mu * self.gaps.iter().map(|g| (-g.gap).max(0.0)).sum::<f64>();
+        let slope: f64 = self
+            .step
+            .iter()
+            .zip(&self.grad)
+            .map(|(s, g)| s * g)
+            .sum::<f64>()
+            - violation;
+        let failed = SolveError::LineSearch {
+            iteration: it,
+            residual: self.res.rel,
         };
-        let merit_info = energy.gradient(state, &mut grad);
-        let merit0 = merit_info.energy + contact_penalty(state);
-        let violation = mu * gaps.iter().map(|g| (-g.gap).max(0.0)).sum::<f64>();
-        let slope: f64 = step.iter().zip(&grad).map(|(s, g)| s * g).sum::<f64>() - violation;
-        if slope >= 0.0 && rel > 1e3 * settings.gradient_tol {
+        if slope >= 0.0 && self.res.rel > 1e3 * self.settings.gradient_tol {
             // not a descent direction (an inexact QP solution with a wrong
             // active set): say so now rather than creep
-            return Err(SolveError::LineSearch {
-                iteration: it,
-                residual: rel,
-            });
+            return Err(failed);
         }
-        let mut merit_at = |alpha: f64| {
-            for (t, v) in trial_step.iter_mut().zip(&step) {
-                *t = alpha * v;
-            }
-            state.displace_into(&map, &trial_step, &mut trial);
-            // continuous collision check: no candidate pair may pass through
-            // contact along the step (sub-steps finer than half a diameter;
-            // pairs beyond the margin cannot close it in one step)
-            if let Some(m) = &contact
-                && !gaps.is_empty()
-            {
-                let largest_move = alpha * largest.min(step_cap);
-                let pieces = ((4.0 * largest_move / m.diameter).ceil() as usize).clamp(1, 64);
-                for k in 1..=pieces {
-                    let f = k as f64 / pieces as f64;
-                    part.iter_mut()
-                        .zip(&trial_step)
-                        .for_each(|(p, x)| *p = f * x);
-                    state.displace_into(&map, &part, &mut sub);
-                    let (points, _) = sub.centreline();
-                    if gaps
-                        .iter()
-                        .any(|g| m.gap_at(&points, g) < -0.5 * m.diameter)
-                    {
-                        return None;
-                    }
-                }
-            }
-            Some(energy.energy(&trial) + contact_penalty(&trial))
-        };
-        let alpha = armijo(merit0, slope, &mut merit_at).ok_or(SolveError::LineSearch {
-            iteration: it,
-            residual: rel,
-        })?;
-        // on a convexified (shifted) step near a saddle the full step can be
-        // far too short: the shift set by the unconstrained Hessian's lowest
-        // eigenvalue damps a direction that is only slightly unstable on the
-        // contacts' tangent space, and the rod would creep away. Extend the
-        // step while the merit keeps falling (up to the step cap)
-        if alpha == 1.0 && shift > 0.0 && m_eq == 0 {
-            let room = step_cap / largest.min(step_cap).max(1e-300);
-            let mut best = (1.0, merit_at(1.0).unwrap_or(f64::INFINITY));
-            let mut a = 2.0;
-            while a <= room.min(1024.0) {
-                match merit_at(a) {
-                    Some(m) if m < best.1 => best = (a, m),
-                    _ => break,
-                }
-                a *= 2.0;
-            }
-            merit_at(best.0);
-        }
-        std::mem::swap(state, &mut trial);
+        armijo(merit0, slope, |alpha| self.merit_at(alpha)).ok_or(failed)
     }
-    Err(report.not_converged())
+
+    /// The exact penalty on the gaps of this iteration's contact pairs.
+    fn contact_penalty(&self, s: &RodState) -> f64 {
+        match &self.contact {
+            Some(m) if !self.gaps.is_empty() => {
+                let (points, _) = s.centreline();
+                self.gaps
+                    .iter()
+                    .map(|g| (-m.gap_at(&points, g)).max(0.0))
+                    .sum::<f64>()
+                    * self.mu
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The merit at `alpha` times the step (the trial state moved there), or
+    /// None if the step passes through a contact.
+    fn merit_at(&mut self, alpha: f64) -> Option<f64> {
+        for (t, v) in self.trial_step.iter_mut().zip(&self.step) {
+            *t = alpha * v;
+        }
+        self.state
+            .displace_into(&self.energy.map, &self.trial_step, &mut self.trial);
+        if self.collides(alpha) {
+            return None;
+        }
+        Some(self.energy.energy(&self.trial) + self.contact_penalty(&self.trial))
+    }
+
+    /// Continuous collision check: no candidate pair may pass through
+    /// contact along the trial step (sub-steps finer than half a diameter;
+    /// pairs beyond the margin cannot close it in one step).
+    fn collides(&mut self, alpha: f64) -> bool {
+        let Some(m) = self.contact else {
+            return false;
+        };
+        if self.gaps.is_empty() {
+            return false;
+        }
+        let largest_move = alpha * self.largest.min(self.step_cap);
+        let pieces = ((4.0 * largest_move / m.diameter).ceil() as usize).clamp(1, 64);
+        for k in 1..=pieces {
+            let f = k as f64 / pieces as f64;
+            self.part
+                .iter_mut()
+                .zip(&self.trial_step)
+                .for_each(|(p, x)| *p = f * x);
+            self.state
+                .displace_into(&self.energy.map, &self.part, &mut self.sub);
+            let (points, _) = self.sub.centreline();
+            if self
+                .gaps
+                .iter()
+                .any(|g| m.gap_at(&points, g) < -0.5 * m.diameter)
+            {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// On a convexified (shifted) step near a saddle the full step can be
+    /// far too short: the shift set by the unconstrained Hessian's lowest
+    /// eigenvalue damps a direction that is only slightly unstable on the
+    /// contacts' tangent space, and the rod would creep away. Extend the
+    /// step while the merit keeps falling (up to the step cap).
+    fn extend_step(&mut self, alpha: f64) {
+        if !(alpha == 1.0 && self.shift > 0.0 && self.m_eq == 0) {
+            return;
+        }
+        let room = self.step_cap / self.largest.min(self.step_cap).max(1e-300);
+        let mut best = (1.0, self.merit_at(1.0).unwrap_or(f64::INFINITY));
+        let mut a = 2.0;
+        while a <= room.min(1024.0) {
+            match self.merit_at(a) {
+                Some(m) if m < best.1 => best = (a, m),
+                _ => break,
+            }
+            a *= 2.0;
+        }
+        self.merit_at(best.0);
+    }
+
+    /// The trial state becomes the iterate.
+    fn accept(&mut self) {
+        std::mem::swap(self.state, &mut self.trial);
+    }
 }
 
 /// The QP with contact rows only, solved exactly by a primal-dual active-set
