@@ -2,6 +2,7 @@
 //! Foxglove's exact schemas, restartable, finalised on Ctrl-C, and read back
 //! with clear errors when damaged.
 
+use knotrod::analysis::event::EventKind;
 use knotrod::io::recording::{
     SCALARS_TOPIC, SCENE_TOPIC, STATE_TOPIC, TF_TOPIC, read_recording, read_state,
 };
@@ -327,4 +328,41 @@ fn contacts_are_recorded_and_drawn() {
     assert_eq!(drawn, 1);
     let r = read_recording(&rec).unwrap();
     assert!(r.scalars[0].contact_force > 0.0);
+}
+
+#[test]
+fn a_recording_written_by_an_earlier_version_reads_back_with_its_fields() {
+    // recordings/samples/fig3_n60.mcap was written by knotrod at git 2ad98bb
+    // (before the layered crate): its events, scalars and states must still
+    // read, with the events' kinds as the typed enum
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("recordings/samples/fig3_n60.mcap");
+    let rec = read_recording(&sample).unwrap();
+    assert_eq!(rec.scalars.len(), 131);
+    for topic in ["/events", "/rod/scalars", "/rod/scene", "/rod/state", "/tf"] {
+        assert!(
+            rec.channels.contains_key(topic),
+            "{topic}: {:?}",
+            rec.channels
+        );
+    }
+    assert_eq!(rec.events.len(), 10);
+    let kinds: Vec<EventKind> = rec.events.iter().map(|e| e.kind).collect();
+    for k in [
+        EventKind::Wall,
+        EventKind::Crossing,
+        EventKind::KnotChange,
+        EventKind::Stability,
+        EventKind::BranchPoint,
+        EventKind::Fold,
+    ] {
+        assert!(kinds.contains(&k), "{k}: {kinds:?}");
+    }
+    let w1 = rec.events.iter().find(|e| e.label == "W1").unwrap();
+    assert_eq!(w1.kind, EventKind::Wall);
+    assert!((w1.phi_over_2pi - 0.77472).abs() < 1e-5, "{w1:?}");
+    assert_eq!(rec.scalars.iter().filter(|s| s.good_knot).count(), 14);
+    let last = read_state(&sample, 130).unwrap();
+    assert_eq!(last.state.segments(), 60);
+    assert_eq!(last.model.segments, 60);
+    assert!(rec.metadata["scene"].contains("[continuation]"));
 }
