@@ -56,37 +56,7 @@ pub enum ReportError {
 /// A report's result.
 pub type Result<T, E = ReportError> = std::result::Result<T, E>;
 
-/// Name the step an error happened in.
-pub trait Context<T> {
-    /// The error, said to have happened in `step`.
-    fn context(self, step: impl Into<String>) -> Result<T>;
-    /// As [`Context::context`], the step made only on failure.
-    fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T>;
-}
-
-impl<T, E: Into<ReportError>> Context<T> for std::result::Result<T, E> {
-    fn context(self, step: impl Into<String>) -> Result<T> {
-        self.map_err(|e| ReportError::At {
-            step: step.into(),
-            source: Box::new(e.into()),
-        })
-    }
-    fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T> {
-        self.map_err(|e| ReportError::At {
-            step: step().into(),
-            source: Box::new(e.into()),
-        })
-    }
-}
-
-impl<T> Context<T> for Option<T> {
-    fn context(self, step: impl Into<String>) -> Result<T> {
-        self.ok_or_else(|| ReportError::Failed(step.into()))
-    }
-    fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T> {
-        self.ok_or_else(|| ReportError::Failed(step().into()))
-    }
-}
+crate::study::error::step_context!(ReportError);
 
 /// Stop a report with a message.
 macro_rules! fail {

@@ -45,37 +45,47 @@ pub enum StudyError {
 /// A study's result.
 pub type Result<T, E = StudyError> = std::result::Result<T, E>;
 
-/// Name the step an error happened in (as anyhow's `context`).
-pub trait Context<T> {
-    /// The error, said to have happened in `step`.
-    fn context(self, step: impl Into<String>) -> Result<T>;
-    /// As [`Context::context`], the step made only on failure.
-    fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T>;
-}
+/// Give an error enum with `At { step, source }` and `Failed(String)`
+/// variants its `Context` trait (as anyhow's `context`): study and report
+/// errors name the steps they happened in the same way.
+macro_rules! step_context {
+    ($error:ident) => {
+        /// Name the step an error happened in (as anyhow's `context`).
+        pub trait Context<T> {
+            /// The error, said to have happened in `step`.
+            fn context(self, step: impl Into<String>) -> Result<T, $error>;
+            /// As [`Context::context`], the step made only on failure.
+            fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T, $error>;
+        }
 
-impl<T, E: Into<StudyError>> Context<T> for std::result::Result<T, E> {
-    fn context(self, step: impl Into<String>) -> Result<T> {
-        self.map_err(|e| StudyError::At {
-            step: step.into(),
-            source: Box::new(e.into()),
-        })
-    }
-    fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T> {
-        self.map_err(|e| StudyError::At {
-            step: step().into(),
-            source: Box::new(e.into()),
-        })
-    }
-}
+        impl<T, E: Into<$error>> Context<T> for std::result::Result<T, E> {
+            fn context(self, step: impl Into<String>) -> Result<T, $error> {
+                self.map_err(|e| $error::At {
+                    step: step.into(),
+                    source: Box::new(e.into()),
+                })
+            }
+            fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T, $error> {
+                self.map_err(|e| $error::At {
+                    step: step().into(),
+                    source: Box::new(e.into()),
+                })
+            }
+        }
 
-impl<T> Context<T> for Option<T> {
-    fn context(self, step: impl Into<String>) -> Result<T> {
-        self.ok_or_else(|| StudyError::Failed(step.into()))
-    }
-    fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T> {
-        self.ok_or_else(|| StudyError::Failed(step().into()))
-    }
+        impl<T> Context<T> for Option<T> {
+            fn context(self, step: impl Into<String>) -> Result<T, $error> {
+                self.ok_or_else(|| $error::Failed(step.into()))
+            }
+            fn with_context<S: Into<String>>(self, step: impl FnOnce() -> S) -> Result<T, $error> {
+                self.ok_or_else(|| $error::Failed(step().into()))
+            }
+        }
+    };
 }
+pub(crate) use step_context;
+
+step_context!(StudyError);
 
 /// An error and its causes, "step: cause: cause" (as anyhow's `{:#}`).
 pub fn describe(e: &(dyn std::error::Error + 'static)) -> String {
