@@ -1,5 +1,7 @@
-//! Scene files (TOML): model, clamps, initial shape, solver settings, outputs.
-//! Every field is checked; errors name the field.
+//! The scene as plain data: model, clamps, initial shape, solver settings,
+//! continuation, loading, map (`map.rs`), contact, outputs; validated section
+//! by section (`validate.rs`), errors naming the field. Files are read in
+//! `io::scene_file`.
 
 mod map;
 mod validate;
