@@ -6,8 +6,8 @@ use crate::geometry::closure::{closure_knot, ray_closure, reach};
 use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
 use crate::geometry::knot::KnotType;
 use crate::geometry::writhe::writhe_closed;
-use crate::linalg::eigen::StabilityError;
 use crate::linalg::eigen::lowest_eigenvalues;
+use crate::linalg::eigen::{Spectrum, StabilityError};
 use crate::model::contact_hessian::ContactHessian;
 use crate::model::energy::{RodEnergy, vertex_strains};
 use crate::model::rod::{Law, RodState};
@@ -265,29 +265,16 @@ fn hold_contacts(
     Some(wide)
 }
 
-/// Measure an equilibrium found by `newton` (its energy is reused for the Hessian).
-pub fn analyse(
+/// The spectrum at an equilibrium: the Hessian's (contacts held) lowest `k`
+/// eigenvalues and inertia, and the pencil's with the lumped mass (the ω²).
+/// `hessian` is the Hessian at `state` when the caller has it already.
+fn stability(
     newton: &mut Minimizer,
     state: &RodState,
     report: &SolveReport,
-    measure: &Measure,
-) -> Result<Equilibrium, AnalysisError> {
-    analyse_from(newton, state, report, measure, None, None)
-}
-
-/// As [`analyse`], for a state reached from the measured equilibrium
-/// `previous` (the writhe and knot type are carried over when no strand can
-/// have passed through another: see [`Conformation::continued`]), and with the
-/// Hessian at `state` when the caller has it already.
-pub fn analyse_from(
-    newton: &mut Minimizer,
-    state: &RodState,
-    report: &SolveReport,
-    measure: &Measure,
-    previous: Option<&Equilibrium>,
+    k: usize,
     hessian: Option<&[f64]>,
-) -> Result<Equilibrium, AnalysisError> {
-    let k = measure.eigenvalues;
+) -> Result<(Spectrum, Vec<f64>), AnalysisError> {
     let energy: &RodEnergy = &newton.energy;
     let values = match hessian {
         Some(h) if h.len() == energy.pattern.nnz() => h.to_vec(),
@@ -321,15 +308,13 @@ pub fn analyse_from(
     } else {
         Vec::new()
     };
-    let reactions = newton.energy.clamp_reactions(state);
-    let (min_z, max_z) = state.z_range();
-    let z_star = state.clamps.z_star;
-    let stable = plain.negative_count == 0 && plain.values.first().is_none_or(|v| *v > 0.0);
-    let shape = Conformation::measure(state, measure, previous);
-    let twist = state.twist();
-    let walled = state.walled();
-    let min_self_distance = shape.self_approach.map_or(f64::INFINITY, |a| a.distance);
-    let law = newton.energy.model.law;
+    Ok((plain, pencil_values))
+}
+
+/// What a constrained law asks to check of its strains: the constraint's
+/// residual max |u2|, and for the strip min |u1| and whether the
+/// regularisation decides the shape somewhere.
+fn strain_checks(law: Law, state: &RodState) -> (Option<f64>, Option<f64>, Option<bool>) {
     let strains: Vec<[f64; 3]> = if law.constrained() {
         (1..=state.segments())
             .map(|i| vertex_strains(state, i))
@@ -358,6 +343,41 @@ pub fn analyse_from(
         ),
         _ => (None, None),
     };
+    (max_u2, min_u1, regularised)
+}
+
+/// Measure an equilibrium found by `newton` (its energy is reused for the Hessian).
+pub fn analyse(
+    newton: &mut Minimizer,
+    state: &RodState,
+    report: &SolveReport,
+    measure: &Measure,
+) -> Result<Equilibrium, AnalysisError> {
+    analyse_from(newton, state, report, measure, None, None)
+}
+
+/// As [`analyse`], for a state reached from the measured equilibrium
+/// `previous` (the writhe and knot type are carried over when no strand can
+/// have passed through another: see [`Conformation::continued`]), and with the
+/// Hessian at `state` when the caller has it already.
+pub fn analyse_from(
+    newton: &mut Minimizer,
+    state: &RodState,
+    report: &SolveReport,
+    measure: &Measure,
+    previous: Option<&Equilibrium>,
+    hessian: Option<&[f64]>,
+) -> Result<Equilibrium, AnalysisError> {
+    let (plain, pencil_values) = stability(newton, state, report, measure.eigenvalues, hessian)?;
+    let reactions = newton.energy.clamp_reactions(state);
+    let (min_z, max_z) = state.z_range();
+    let z_star = state.clamps.z_star;
+    let stable = plain.negative_count == 0 && plain.values.first().is_none_or(|v| *v > 0.0);
+    let shape = Conformation::measure(state, measure, previous);
+    let twist = state.twist();
+    let walled = state.walled();
+    let min_self_distance = shape.self_approach.map_or(f64::INFINITY, |a| a.distance);
+    let (max_u2, min_u1, regularised) = strain_checks(newton.energy.model.law, state);
     Ok(Equilibrium {
         z_star,
         delta: state.clamps.delta,

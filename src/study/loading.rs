@@ -4,7 +4,7 @@
 //! being a minimum the rod jumps: the jump is detected (loss of stability of
 //! the carried state, large change of shape or of link) and recorded.
 
-use crate::analysis::equilibrium::{Measure, analyse, analyse_from};
+use crate::analysis::equilibrium::{Equilibrium, Measure, analyse, analyse_from};
 use crate::analysis::event::{Event, EventKind};
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::rod::{Clamps, RodState};
@@ -217,10 +217,15 @@ pub fn run_loading(
     measure: &Measure,
     observer: &mut Observer<'_>,
 ) -> Result<Vec<Event>> {
-    let mut events = Vec::new();
     let report = minimize_to_stable(newton, &mut state, settings)?;
     let mut eq = analyse(newton, &state, &report, measure)?;
     observer(eq.clone())?;
+    let mut hand = Hand {
+        newton,
+        settings,
+        measure,
+        events: Vec::new(),
+    };
     for (leg, stage) in path.iter().enumerate() {
         let c0 = state.clamps;
         let target = Clamps {
@@ -238,106 +243,178 @@ pub fn run_loading(
                 delta: c0.delta + f * (target.delta - c0.delta),
                 phi: c0.phi + f * (target.phi - c0.phi),
             };
-            let context = || format!("loading leg {leg}, step {k}");
-            let mut step = move_clamps(newton, &state, c, settings).with_context(context)?;
-            let mut next =
-                analyse_from(newton, &step.state, &step.report, measure, Some(&eq), None)?;
-            if step.jumped || link_jump(&eq, &next).abs() > JUMP_LINK {
-                // a hand moves slowly: the rod jumps where its branch ends, not
-                // where a finite step happened to overshoot
-                let mut lo_eq = eq.clone();
-                let (lo_state, hi) = locate_on_path(newton, &state, c, settings, &mut |nw, t| {
-                    let t_eq = analyse_from(nw, &t.state, &t.report, measure, Some(&lo_eq), None)?;
-                    let same = !t.jumped && link_jump(&lo_eq, &t_eq).abs() <= JUMP_LINK;
-                    if same {
-                        lo_eq = t_eq;
-                    }
-                    Ok(same)
-                })
-                .with_context(context)?;
-                // the last step from the end of the branch jumps; the rod then
-                // moves on from where it landed to this step's clamps
-                let landed = move_clamps(newton, &lo_state, hi, settings).with_context(context)?;
-                let landed_eq = analyse_from(
-                    newton,
-                    &landed.state,
-                    &landed.report,
-                    measure,
-                    Some(&lo_eq),
-                    None,
-                )?;
-                if landed.jumped || link_jump(&lo_eq, &landed_eq).abs() > JUMP_LINK {
-                    events.push(path_event(
-                        // the link changes by ±2 without a jump when the
-                        // centreline passes through itself (no contact model)
-                        if landed.jumped {
-                            EventKind::Jump
-                        } else {
-                            EventKind::Crossing
-                        },
-                        &hi,
-                        lo_eq.twist,
-                        leg,
-                        format!(
-                            "lands {:.4} from the prediction, link {:.3} → {:.3}, twist {:.3} → {:.3}",
-                            landed.miss, lo_eq.link, landed_eq.link, lo_eq.twist, landed_eq.twist
-                        ),
-                    ));
-                    step = move_clamps(newton, &landed.state, c, settings).with_context(context)?;
-                    next = analyse_from(
-                        newton,
-                        &step.state,
-                        &step.report,
-                        measure,
-                        Some(&landed_eq),
-                        None,
-                    )?;
-                }
-            }
+            let at = Leg {
+                from: &state,
+                eq: &eq,
+                to: c,
+                leg,
+                k,
+            };
+            let (step, next) = hand.advance(&at)?;
             if eq.walled != next.walled && !step.jumped {
-                // entering or leaving the walls: locate it on the branch
-                let inside = eq.walled;
-                let (_, hi) = locate_on_path(newton, &state, c, settings, &mut |_, t| {
-                    Ok(t.state.walled() == inside)
-                })
-                .with_context(context)?;
-                let detail = if inside {
-                    "leaves the walls"
-                } else {
-                    "enters the walls"
-                };
-                events.push(path_event(
-                    EventKind::Wall,
-                    &hi,
-                    eq.twist,
-                    leg,
-                    detail.into(),
-                ));
+                hand.locate_wall(&at)?;
             }
             if !eq.contacts.is_empty() && next.contacts.is_empty() {
-                // the last contact opens: locate where its force reaches zero
-                let (_, hi) = locate_on_path(newton, &state, c, settings, &mut |_, t| {
-                    Ok(!t.report.contacts.is_empty())
-                })
-                .with_context(context)?;
-                let names: Vec<&str> = eq.contacts.iter().map(|c| c.obstacle.as_str()).collect();
-                let detail = format!(
-                    "contacts {} → none (total force {:.3} before)",
-                    names.join(", "),
-                    eq.contact_force
-                );
-                events.push(path_event(
-                    EventKind::ContactLost,
-                    &hi,
-                    eq.twist,
-                    leg,
-                    detail,
-                ));
+                hand.locate_contact_loss(&at)?;
             }
             observer(next.clone())?;
             state = step.state;
             eq = next;
         }
     }
-    Ok(events)
+    Ok(hand.events)
+}
+
+/// The hand that moves the clamp, and the events it has seen.
+struct Hand<'n> {
+    newton: &'n mut Minimizer,
+    settings: &'n SolverSettings,
+    measure: &'n Measure,
+    events: Vec<Event>,
+}
+
+/// One step of a loading path: from the equilibrium `eq` (state `from`) to
+/// the clamps `to`, step `k` of leg `leg`.
+struct Leg<'s> {
+    from: &'s RodState,
+    eq: &'s Equilibrium,
+    to: Clamps,
+    leg: usize,
+    k: usize,
+}
+
+impl Leg<'_> {
+    fn context(&self) -> String {
+        format!("loading leg {}, step {}", self.leg, self.k)
+    }
+}
+
+impl Hand<'_> {
+    /// Move the clamps one step and settle; where the rod jumps, follow it
+    /// (see [`Hand::follow_jump`]).
+    fn advance(&mut self, at: &Leg) -> Result<(Step, Equilibrium)> {
+        let (newton, measure) = (&mut *self.newton, self.measure);
+        let step =
+            move_clamps(newton, at.from, at.to, self.settings).with_context(|| at.context())?;
+        let next = analyse_from(
+            newton,
+            &step.state,
+            &step.report,
+            measure,
+            Some(at.eq),
+            None,
+        )?;
+        if step.jumped || link_jump(at.eq, &next).abs() > JUMP_LINK {
+            return self.follow_jump(at, step, next);
+        }
+        Ok((step, next))
+    }
+
+    /// A hand moves slowly: the rod jumps where its branch ends, not where a
+    /// finite step happened to overshoot. Locate the end on the path, record
+    /// the jump (or the crossing), and move on from where the rod landed.
+    fn follow_jump(
+        &mut self,
+        at: &Leg,
+        step: Step,
+        next: Equilibrium,
+    ) -> Result<(Step, Equilibrium)> {
+        let (settings, measure) = (self.settings, self.measure);
+        let mut lo_eq = at.eq.clone();
+        let (lo_state, hi) = locate_on_path(self.newton, at.from, at.to, settings, &mut |nw, t| {
+            let t_eq = analyse_from(nw, &t.state, &t.report, measure, Some(&lo_eq), None)?;
+            let same = !t.jumped && link_jump(&lo_eq, &t_eq).abs() <= JUMP_LINK;
+            if same {
+                lo_eq = t_eq;
+            }
+            Ok(same)
+        })
+        .with_context(|| at.context())?;
+        // the last step from the end of the branch jumps; the rod then
+        // moves on from where it landed to this step's clamps
+        let newton = &mut *self.newton;
+        let landed = move_clamps(newton, &lo_state, hi, settings).with_context(|| at.context())?;
+        let landed_eq = analyse_from(
+            newton,
+            &landed.state,
+            &landed.report,
+            measure,
+            Some(&lo_eq),
+            None,
+        )?;
+        if !(landed.jumped || link_jump(&lo_eq, &landed_eq).abs() > JUMP_LINK) {
+            return Ok((step, next));
+        }
+        self.events.push(path_event(
+            // the link changes by ±2 without a jump when the centreline
+            // passes through itself (no contact model)
+            if landed.jumped {
+                EventKind::Jump
+            } else {
+                EventKind::Crossing
+            },
+            &hi,
+            lo_eq.twist,
+            at.leg,
+            format!(
+                "lands {:.4} from the prediction, link {:.3} → {:.3}, twist {:.3} → {:.3}",
+                landed.miss, lo_eq.link, landed_eq.link, lo_eq.twist, landed_eq.twist
+            ),
+        ));
+        let step =
+            move_clamps(newton, &landed.state, at.to, settings).with_context(|| at.context())?;
+        let next = analyse_from(
+            newton,
+            &step.state,
+            &step.report,
+            measure,
+            Some(&landed_eq),
+            None,
+        )?;
+        Ok((step, next))
+    }
+
+    /// Entering or leaving the walls: locate it on the branch.
+    fn locate_wall(&mut self, at: &Leg) -> Result<()> {
+        let inside = at.eq.walled;
+        let (_, hi) = locate_on_path(self.newton, at.from, at.to, self.settings, &mut |_, t| {
+            Ok(t.state.walled() == inside)
+        })
+        .with_context(|| at.context())?;
+        let detail = if inside {
+            "leaves the walls"
+        } else {
+            "enters the walls"
+        };
+        self.events.push(path_event(
+            EventKind::Wall,
+            &hi,
+            at.eq.twist,
+            at.leg,
+            detail.into(),
+        ));
+        Ok(())
+    }
+
+    /// The last contact opens: locate where its force reaches zero.
+    fn locate_contact_loss(&mut self, at: &Leg) -> Result<()> {
+        let (_, hi) = locate_on_path(self.newton, at.from, at.to, self.settings, &mut |_, t| {
+            Ok(!t.report.contacts.is_empty())
+        })
+        .with_context(|| at.context())?;
+        let names: Vec<&str> = at.eq.contacts.iter().map(|c| c.obstacle.as_str()).collect();
+        let detail = format!(
+            "contacts {} → none (total force {:.3} before)",
+            names.join(", "),
+            at.eq.contact_force
+        );
+        self.events.push(path_event(
+            EventKind::ContactLost,
+            &hi,
+            at.eq.twist,
+            at.leg,
+            detail,
+        ));
+        Ok(())
+    }
 }
