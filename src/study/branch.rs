@@ -227,6 +227,8 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             + a.tangent_p * b.tangent_p
     }
 
+    /// The events between the consecutive points `a` and `b` (test values
+    /// `wa`, `wb`, arclength `ds` apart), each located by bisection.
     fn locate_events(
         &mut self,
         a: &Point,
@@ -236,82 +238,122 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         ds: f64,
         branch: usize,
     ) -> Result<()> {
-        let measure = self.options.measure;
         let fold = a.tangent_p * b.tangent_p < 0.0;
         if fold {
-            let s = a.tangent_p.signum();
-            let p = self
-                .locate(a, ds, &mut |_, p| p.tangent_p.signum() == s)
-                .context("locating a fold")?;
-            let detail = format!(
-                "negative eigenvalues {} → {}",
-                a.negative_count, b.negative_count
-            );
-            if a.negative_count == b.negative_count {
-                // φ extremal while no eigenvalue changes sign: an eigenvalue
-                // touches zero where an asymmetric branch meets the symmetric
-                // one, and the path goes on along the mirror image (same
-                // φ, Tw, walls): a symmetric branch point, not a fold
-                let detail =
-                    format!("{detail}; through a symmetric branch point onto the mirror branch");
-                self.events
-                    .push(event(EventKind::BranchPoint, &p, branch, detail));
-            } else {
-                self.events.push(event(EventKind::Fold, &p, branch, detail));
-            }
+            self.locate_fold(a, b, ds, branch)?;
         }
         if a.negative_count != b.negative_count {
-            let na = a.negative_count;
-            let p = self
-                .locate(a, ds, &mut |_, p| p.negative_count == na)
-                .context("locating a change of stability")?;
-            let detail = format!("negative eigenvalues {} → {}", na, b.negative_count);
-            self.events
-                .push(event(EventKind::Stability, &p, branch, detail.clone()));
-            if !fold {
-                let (lambda, null) = self.tracer.lowest_mode(&p)?;
-                self.events.push(event(
-                    EventKind::BranchPoint,
-                    &p,
-                    branch,
-                    format!("{detail}; eigenvalue there {lambda:.2e}"),
-                ));
-                self.branch_points.push((p, null, branch));
-            }
+            self.locate_stability_change(a, b, ds, branch, fold)?;
         }
         if (wa.wall > 0.0) != (wb.wall > 0.0) {
-            let inside = wa.wall > 0.0;
-            let p = self
-                .locate(a, ds, &mut |_, p| {
-                    (p.state.wall_clearance() > 0.0) == inside
-                })
-                .context("locating a wall")?;
-            let detail = if inside {
-                "leaves the walls"
-            } else {
-                "enters the walls"
-            };
-            self.events
-                .push(event(EventKind::Wall, &p, branch, detail.into()));
+            self.locate_wall(a, wa, ds, branch)?;
         }
         if wa.knot != wb.knot || (wb.link - wa.link).abs() > 1.0 {
-            let (ka, la) = (wa.knot, wa.link);
-            let p = self
-                .locate(a, ds, &mut |_, p| {
-                    let (knot, link) = knot_of(&p.state, &measure);
-                    knot == ka && (link - la).abs() < 1.0
-                })
-                .context("locating a crossing")?;
-            let detail = format!(
-                "knot determinant {} → {}, link {:.3} → {:.3}",
-                wa.knot, wb.knot, wa.link, wb.link
-            );
+            self.locate_crossing(a, wa, wb, ds, branch)?;
+        }
+        Ok(())
+    }
+
+    /// The parameter turns back: a fold, or a symmetric branch point.
+    fn locate_fold(&mut self, a: &Point, b: &Point, ds: f64, branch: usize) -> Result<()> {
+        let s = a.tangent_p.signum();
+        let p = self
+            .locate(a, ds, &mut |_, p| p.tangent_p.signum() == s)
+            .context("locating a fold")?;
+        let detail = format!(
+            "negative eigenvalues {} → {}",
+            a.negative_count, b.negative_count
+        );
+        if a.negative_count == b.negative_count {
+            // φ extremal while no eigenvalue changes sign: an eigenvalue
+            // touches zero where an asymmetric branch meets the symmetric
+            // one, and the path goes on along the mirror image (same
+            // φ, Tw, walls): a symmetric branch point, not a fold
+            let detail =
+                format!("{detail}; through a symmetric branch point onto the mirror branch");
             self.events
-                .push(event(EventKind::Crossing, &p, branch, detail.clone()));
-            if wa.knot != wb.knot {
-                self.events
-                    .push(event(EventKind::KnotChange, &p, branch, detail));
-            }
+                .push(event(EventKind::BranchPoint, &p, branch, detail));
+        } else {
+            self.events.push(event(EventKind::Fold, &p, branch, detail));
+        }
+        Ok(())
+    }
+
+    /// An eigenvalue changes sign; without a fold it is a branch point,
+    /// whose null vector is kept to switch onto the bifurcating branches.
+    fn locate_stability_change(
+        &mut self,
+        a: &Point,
+        b: &Point,
+        ds: f64,
+        branch: usize,
+        fold: bool,
+    ) -> Result<()> {
+        let na = a.negative_count;
+        let p = self
+            .locate(a, ds, &mut |_, p| p.negative_count == na)
+            .context("locating a change of stability")?;
+        let detail = format!("negative eigenvalues {} → {}", na, b.negative_count);
+        self.events
+            .push(event(EventKind::Stability, &p, branch, detail.clone()));
+        if !fold {
+            let (lambda, null) = self.tracer.lowest_mode(&p)?;
+            self.events.push(event(
+                EventKind::BranchPoint,
+                &p,
+                branch,
+                format!("{detail}; eigenvalue there {lambda:.2e}"),
+            ));
+            self.branch_points.push((p, null, branch));
+        }
+        Ok(())
+    }
+
+    /// The rod enters or leaves the walls.
+    fn locate_wall(&mut self, a: &Point, wa: &TestValues, ds: f64, branch: usize) -> Result<()> {
+        let inside = wa.wall > 0.0;
+        let p = self
+            .locate(a, ds, &mut |_, p| {
+                (p.state.wall_clearance() > 0.0) == inside
+            })
+            .context("locating a wall")?;
+        let detail = if inside {
+            "leaves the walls"
+        } else {
+            "enters the walls"
+        };
+        self.events
+            .push(event(EventKind::Wall, &p, branch, detail.into()));
+        Ok(())
+    }
+
+    /// The centreline passes through itself (the link jumps by ±2), and the
+    /// knot type may change there.
+    fn locate_crossing(
+        &mut self,
+        a: &Point,
+        wa: &TestValues,
+        wb: &TestValues,
+        ds: f64,
+        branch: usize,
+    ) -> Result<()> {
+        let measure = self.options.measure;
+        let (ka, la) = (wa.knot, wa.link);
+        let p = self
+            .locate(a, ds, &mut |_, p| {
+                let (knot, link) = knot_of(&p.state, &measure);
+                knot == ka && (link - la).abs() < 1.0
+            })
+            .context("locating a crossing")?;
+        let detail = format!(
+            "knot determinant {} → {}, link {:.3} → {:.3}",
+            wa.knot, wb.knot, wa.link, wb.link
+        );
+        self.events
+            .push(event(EventKind::Crossing, &p, branch, detail.clone()));
+        if wa.knot != wb.knot {
+            self.events
+                .push(event(EventKind::KnotChange, &p, branch, detail));
         }
         Ok(())
     }

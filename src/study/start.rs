@@ -20,85 +20,106 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
     if init.from_recording.is_some() {
         return restart_state(init, "initial.from_recording", n, clamps);
     }
-    Ok(match init.shape {
-        InitialShape::Straight => match init.bump {
-            None => RodState::straight(n, clamps),
-            Some(b) => {
-                let (end, phi, b) = (clamps.end_point(), clamps.phi, Vector3::from(b));
-                RodState::from_curve(
-                    n,
-                    clamps,
-                    move |s| end * s + b * (0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos())),
-                    move |s| Vector3::new((phi * s).cos(), (phi * s).sin(), 0.0),
-                )
-            }
-        },
-        InitialShape::DoubleRing => {
-            // a circle of circumference 1/2 traced twice in the (y, z) plane,
-            // bent about d1 = e1 everywhere (paper Sec. 6); the clamps are the
-            // scene's, so small z*, δ, 2π − φ start the unfolding directly
-            let r = 1.0 / (4.0 * std::f64::consts::PI);
+    match init.shape {
+        InitialShape::Straight => Ok(straight(n, clamps, init.bump)),
+        InitialShape::DoubleRing => Ok(double_ring(n, clamps)),
+        InitialShape::Trefoil => trefoil(scene, n, clamps),
+        InitialShape::Shooting => shooting(init, model, clamps),
+        InitialShape::File => restart_state(init, "initial.file", n, clamps),
+    }
+}
+
+/// Straight from clamp to clamp, uniformly twisted by φ, with an optional
+/// clamped-clamped bump b (1 − cos 2πs)/2 to seed buckling.
+fn straight(n: usize, clamps: Clamps, bump: Option<[f64; 3]>) -> RodState {
+    match bump {
+        None => RodState::straight(n, clamps),
+        Some(b) => {
+            let (end, phi, b) = (clamps.end_point(), clamps.phi, Vector3::from(b));
             RodState::from_curve(
                 n,
                 clamps,
-                move |s| {
-                    let a = 4.0 * std::f64::consts::PI * s;
-                    Vector3::new(0.0, -r * (1.0 - a.cos()), r * a.sin())
-                },
-                |_| Vector3::x(),
+                move |s| end * s + b * (0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos())),
+                move |s| Vector3::new((phi * s).cos(), (phi * s).sin(), 0.0),
             )
         }
-        InitialShape::Trefoil => {
-            let mut state = RodState::from_curve(
-                n,
-                clamps,
-                crate::model::trefoil::trefoil_centreline(clamps.end_point()),
-                |_| Vector3::x(),
-            );
-            // uniform twist, with the whole turns that give the asked link:
-            // m_i = c at every vertex, n c = φ + reference twist at the end
-            let target = init.link.unwrap_or(3) as f64 + clamps.phi_over_2pi();
-            let rt = state.reference_twist[n];
-            let set = |state: &mut RodState, turns: f64| {
-                let c = (clamps.phi + rt + 2.0 * std::f64::consts::PI * turns) / n as f64;
-                for j in 1..n {
-                    state.theta[j] = j as f64 * c;
-                }
-                state.reference_twist[n] = rt + 2.0 * std::f64::consts::PI * turns;
-            };
-            set(&mut state, 0.0);
-            let shape = Conformation::of(&state, &scene.measure());
-            if !is_trefoil(shape.knot.determinant) {
-                return Err(SceneError::Invalid {
-                    field: "initial.shape",
-                    reason: format!(
-                        "\"trefoil\": at z* = {}, δ = {} the guide curve's ray closure is \
-                         not a trefoil (knot determinant {}); start from the paper's clamps \
-                         (z* ≈ 0.115, δ ≈ 0.05) and load from there",
-                        clamps.z_star, clamps.delta, shape.knot.determinant
-                    ),
-                }
-                .into());
-            }
-            let turns = (target - state.twist() - shape.writhe).round();
-            set(&mut state, turns);
-            state
+    }
+}
+
+/// A circle of circumference 1/2 traced twice in the (y, z) plane, bent
+/// about d1 = e1 everywhere (paper Sec. 6); the clamps are the scene's, so
+/// small z*, δ, 2π − φ start the unfolding directly.
+fn double_ring(n: usize, clamps: Clamps) -> RodState {
+    let r = 1.0 / (4.0 * std::f64::consts::PI);
+    RodState::from_curve(
+        n,
+        clamps,
+        move |s| {
+            let a = 4.0 * std::f64::consts::PI * s;
+            Vector3::new(0.0, -r * (1.0 - a.cos()), r * a.sin())
+        },
+        |_| Vector3::x(),
+    )
+}
+
+/// The open trefoil tied around the rays, uniformly twisted with the whole
+/// turns that give the asked link (`initial.link`, default 3); an error
+/// naming the field where the guide curve is not a trefoil at these clamps.
+fn trefoil(scene: &Scene, n: usize, clamps: Clamps) -> Result<RodState> {
+    let mut state = RodState::from_curve(
+        n,
+        clamps,
+        crate::model::trefoil::trefoil_centreline(clamps.end_point()),
+        |_| Vector3::x(),
+    );
+    // m_i = c at every vertex, n c = φ + reference twist at the end
+    let target = scene.initial.link.unwrap_or(3) as f64 + clamps.phi_over_2pi();
+    let rt = state.reference_twist[n];
+    let set = |state: &mut RodState, turns: f64| {
+        let c = (clamps.phi + rt + 2.0 * std::f64::consts::PI * turns) / n as f64;
+        for j in 1..n {
+            state.theta[j] = j as f64 * c;
         }
-        InitialShape::Shooting => {
-            let (mut n0, mut m0) = (
-                Vector3::from(init.n0.context("initial.n0 missing")?),
-                Vector3::from(init.m0.context("initial.m0 missing")?),
-            );
-            let steps = init.steps.map_or(20_000, |s| s as usize);
-            if init.refine {
-                (n0, m0) = refine_shooting(n0, m0, model.k2, model.k3, &clamps, steps)
-                    .context("initial.refine: shooting refinement did not converge")?;
-            }
-            let sol = ShootingSolution::integrate(n0, m0, model.k2, model.k3, steps);
-            RodState::from_curve(n, clamps, |s| sol.position(s), |s| sol.d1(s))
+        state.reference_twist[n] = rt + 2.0 * std::f64::consts::PI * turns;
+    };
+    set(&mut state, 0.0);
+    let shape = Conformation::of(&state, &scene.measure());
+    if !is_trefoil(shape.knot.determinant) {
+        return Err(SceneError::Invalid {
+            field: "initial.shape",
+            reason: format!(
+                "\"trefoil\": at z* = {}, δ = {} the guide curve's ray closure is \
+                 not a trefoil (knot determinant {}); start from the paper's clamps \
+                 (z* ≈ 0.115, δ ≈ 0.05) and load from there",
+                clamps.z_star, clamps.delta, shape.knot.determinant
+            ),
         }
-        InitialShape::File => restart_state(init, "initial.file", n, clamps)?,
-    })
+        .into());
+    }
+    let turns = (target - state.twist() - shape.writhe).round();
+    set(&mut state, turns);
+    Ok(state)
+}
+
+/// The continuum solution integrated (A.2) from n(0), m(0), refined first on
+/// the s = 1 boundary conditions if asked.
+fn shooting(init: &InitialSpec, model: &RodModel, clamps: Clamps) -> Result<RodState> {
+    let (mut n0, mut m0) = (
+        Vector3::from(init.n0.context("initial.n0 missing")?),
+        Vector3::from(init.m0.context("initial.m0 missing")?),
+    );
+    let steps = init.steps.map_or(20_000, |s| s as usize);
+    if init.refine {
+        (n0, m0) = refine_shooting(n0, m0, model.k2, model.k3, &clamps, steps)
+            .context("initial.refine: shooting refinement did not converge")?;
+    }
+    let sol = ShootingSolution::integrate(n0, m0, model.k2, model.k3, steps);
+    Ok(RodState::from_curve(
+        model.segments,
+        clamps,
+        |s| sol.position(s),
+        |s| sol.d1(s),
+    ))
 }
 
 /// The restart state of `[initial]` (read from `field`'s file when the scene
