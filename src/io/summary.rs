@@ -3,7 +3,7 @@
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
 use crate::model::rod::RodModel;
-use crate::scene::Scene;
+use crate::scene::{ReferenceSpec, Scene};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::Path;
@@ -164,55 +164,65 @@ pub fn print_equilibrium(
         if e.good_knot { "YES" } else { "no" }
     )?;
     if let Some(r) = &scene.reference {
-        let src = r.source.as_deref().unwrap_or("reference");
-        writeln!(out, "  compared with {src}:")?;
-        if let Some(n0) = &r.n0 {
-            writeln!(
-                out,
-                "    n(0) {}: relative deviation {:.3}%",
-                vec3(n0),
-                100.0 * relative_deviation(&e.n0, n0)
-            )?;
-        }
-        if let Some(m0) = &r.m0 {
-            writeln!(
-                out,
-                "    m(0) {}: relative deviation {:.3}%",
-                vec3(m0),
-                100.0 * relative_deviation(&e.m0, m0)
-            )?;
-        }
-        if let Some(tw) = r.twist {
-            writeln!(out, "    Tw {tw}: difference {:+.4}", e.twist - tw)?;
-        }
-        if let Some(l) = r.link {
-            writeln!(out, "    link {l}: difference {:+.4}", e.link - l)?;
-        }
-        if let Some(d) = r.knot_determinant {
-            writeln!(
-                out,
-                "    knot determinant {d}: {}",
-                if d == e.knot_determinant {
-                    "agrees"
-                } else {
-                    "DISAGREES"
-                }
-            )?;
-        }
-        if let Some(w) = r.walled {
-            writeln!(
-                out,
-                "    walled {w}: {}",
-                if w == e.walled { "agrees" } else { "DISAGREES" }
-            )?;
-        }
-        if let Some(s) = r.stable {
-            writeln!(
-                out,
-                "    stable {s}: {}",
-                if s == e.stable { "agrees" } else { "DISAGREES" }
-            )?;
-        }
+        print_comparison(e, r, out)?;
+    }
+    Ok(())
+}
+
+/// Our equilibrium beside a scene's published values, with our deviation.
+fn print_comparison(
+    e: &Equilibrium,
+    r: &ReferenceSpec,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
+    let src = r.source.as_deref().unwrap_or("reference");
+    writeln!(out, "  compared with {src}:")?;
+    if let Some(n0) = &r.n0 {
+        writeln!(
+            out,
+            "    n(0) {}: relative deviation {:.3}%",
+            vec3(n0),
+            100.0 * relative_deviation(&e.n0, n0)
+        )?;
+    }
+    if let Some(m0) = &r.m0 {
+        writeln!(
+            out,
+            "    m(0) {}: relative deviation {:.3}%",
+            vec3(m0),
+            100.0 * relative_deviation(&e.m0, m0)
+        )?;
+    }
+    if let Some(tw) = r.twist {
+        writeln!(out, "    Tw {tw}: difference {:+.4}", e.twist - tw)?;
+    }
+    if let Some(l) = r.link {
+        writeln!(out, "    link {l}: difference {:+.4}", e.link - l)?;
+    }
+    if let Some(d) = r.knot_determinant {
+        writeln!(
+            out,
+            "    knot determinant {d}: {}",
+            if d == e.knot_determinant {
+                "agrees"
+            } else {
+                "DISAGREES"
+            }
+        )?;
+    }
+    if let Some(w) = r.walled {
+        writeln!(
+            out,
+            "    walled {w}: {}",
+            if w == e.walled { "agrees" } else { "DISAGREES" }
+        )?;
+    }
+    if let Some(s) = r.stable {
+        writeln!(
+            out,
+            "    stable {s}: {}",
+            if s == e.stable { "agrees" } else { "DISAGREES" }
+        )?;
     }
     Ok(())
 }
