@@ -125,6 +125,87 @@ impl Newton {
         Err(report.not_converged())
     }
 
+    /// Factor H + shift·I with the smallest shift, from `first`, that makes
+    /// it positive definite: after a zero shift 0.1 × `previous` (at least
+    /// 1e-8 × `diag_scale`), then ×10. Returns the shift used.
+    #[allow(clippy::too_many_arguments)]
+    fn factor_shifted(
+        &mut self,
+        energy: &RodEnergy,
+        ldlt: &mut Ldlt,
+        first: f64,
+        previous: f64,
+        diag_scale: f64,
+        report: &mut SolveReport,
+        it: usize,
+    ) -> Result<f64, SolveError> {
+        let mut shift = first;
+        loop {
+            for &s in &energy.pattern.diagonal {
+                self.values[s] += shift;
+            }
+            report.factorizations += 1;
+            let ok = ldlt.factor(&self.values).is_ok() && ldlt.negative_count() == 0;
+            for &s in &energy.pattern.diagonal {
+                self.values[s] -= shift;
+            }
+            if ok {
+                return Ok(shift);
+            }
+            shift = if shift == 0.0 {
+                (0.1 * previous).max(1e-8 * diag_scale)
+            } else {
+                shift * 10.0
+            };
+            if shift > 1e6 * diag_scale {
+                return Err(SolveError::NonFinite {
+                    step: "Hessian regularisation",
+                    iteration: it,
+                });
+            }
+        }
+    }
+
+    /// The (shifted) Newton step −(H + shift)⁻¹∇E from the factorisation in
+    /// `ldlt`, replaced near a saddle by a step along negative curvature, and
+    /// capped to a largest node move of `max_step`.
+    fn newton_step(
+        &mut self,
+        energy: &RodEnergy,
+        ldlt: &mut Ldlt,
+        shift: f64,
+        rel: f64,
+        max_step: f64,
+        it: usize,
+    ) -> Result<(), SolveError> {
+        for (s, g) in self.step.iter_mut().zip(&self.grad) {
+            *s = -g;
+        }
+        ldlt.solve_in_place(&mut self.step);
+        if self.step.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::NonFinite {
+                step: "Newton step",
+                iteration: it,
+            });
+        }
+        // near a saddle (small gradient, H indefinite) a shifted Newton step
+        // creeps: step off along the direction of negative curvature instead
+        if shift > 0.0 && rel < 1e-6 {
+            self.negative_curvature_step(energy, ldlt);
+        }
+        // cap the largest node move
+        let map = energy.map;
+        let largest = (0..self.step.len())
+            .filter(|&d| map.is_translation(d))
+            .map(|d| self.step[d].abs())
+            .fold(0.0, f64::max);
+        if largest > max_step {
+            let f = max_step / largest;
+            self.step.iter_mut().for_each(|v| *v *= f);
+        }
+        Ok(())
+    }
+
     /// Newton minimisation that stops early (not converged) at the first
     /// accepted iterate where `stop` holds.
     pub fn minimize_until(
@@ -156,56 +237,17 @@ impl Newton {
             // (quadratic convergence near a minimum), after a cut step a
             // larger shift; raise it until H + shift is positive definite
             let previous = shift;
-            shift = next_shift;
-            loop {
-                for &s in &energy.pattern.diagonal {
-                    self.values[s] += shift;
-                }
-                report.factorizations += 1;
-                let ok = ldlt.factor(&self.values).is_ok() && ldlt.negative_count() == 0;
-                for &s in &energy.pattern.diagonal {
-                    self.values[s] -= shift;
-                }
-                if ok {
-                    break;
-                }
-                shift = if shift == 0.0 {
-                    (0.1 * previous).max(1e-8 * diag_scale)
-                } else {
-                    shift * 10.0
-                };
-                if shift > 1e6 * diag_scale {
-                    return Err(SolveError::NonFinite {
-                        step: "Hessian regularisation",
-                        iteration: it,
-                    });
-                }
-            }
-            for (s, g) in self.step.iter_mut().zip(&self.grad) {
-                *s = -g;
-            }
-            ldlt.solve_in_place(&mut self.step);
-            if self.step.iter().any(|v| !v.is_finite()) {
-                return Err(SolveError::NonFinite {
-                    step: "Newton step",
-                    iteration: it,
-                });
-            }
+            shift = self.factor_shifted(
+                energy,
+                ldlt,
+                next_shift,
+                previous,
+                diag_scale,
+                &mut report,
+                it,
+            )?;
+            self.newton_step(energy, ldlt, shift, rel, settings.max_step, it)?;
             let map = energy.map;
-            // near a saddle (small gradient, H indefinite) a shifted Newton step
-            // creeps: step off along the direction of negative curvature instead
-            if shift > 0.0 && rel < 1e-6 {
-                self.negative_curvature_step(energy, ldlt);
-            }
-            // cap the largest node move
-            let largest = (0..self.step.len())
-                .filter(|&d| map.is_translation(d))
-                .map(|d| self.step[d].abs())
-                .fold(0.0, f64::max);
-            if largest > settings.max_step {
-                let f = settings.max_step / largest;
-                self.step.iter_mut().for_each(|v| *v *= f);
-            }
             // Armijo backtracking on the energy
             let slope: f64 = self.step.iter().zip(&self.grad).map(|(s, g)| s * g).sum();
             let (step, trial_step) = (&self.step, &mut self.trial_step);
