@@ -419,8 +419,9 @@ impl RodState {
     /// Clearance of the interior extrema of z from the walls z = 0 and z = z*
     /// (negative: outside; see [`wall_clearance`]).
     pub fn wall_clearance(&self) -> f64 {
-        let (points, _) = self.centreline();
-        let heights: Vec<f64> = points[1..points.len() - 1].iter().map(|p| p.z).collect();
+        // the interior nodes 1..=N are the centreline without its clamp ends
+        let n = self.segments();
+        let heights: Vec<f64> = self.nodes[1..=n].iter().map(|p| p.z).collect();
         wall_clearance(&heights, self.clamps.z_star)
     }
 

@@ -12,27 +12,12 @@ use crate::study::error::StudyError;
 /// A report that could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {
-    /// A study behind it failed.
+    /// A study behind it failed (the library's own errors arrive as one).
     #[error(transparent)]
     Study(#[from] StudyError),
-    /// A scene could not be used.
-    #[error(transparent)]
-    Scene(#[from] SceneError),
     /// A map's files could not be used.
     #[error(transparent)]
     MapFile(#[from] MapFileError),
-    /// A minimisation failed.
-    #[error(transparent)]
-    Solve(#[from] SolveError),
-    /// A continuation step failed.
-    #[error(transparent)]
-    Continuation(#[from] ContinuationError),
-    /// A stability analysis failed.
-    #[error(transparent)]
-    Stability(#[from] StabilityError),
-    /// Measuring an equilibrium failed.
-    #[error(transparent)]
-    Analysis(#[from] AnalysisError),
     /// Writing the text failed.
     #[error("writing the report: {0}")]
     Format(#[from] std::fmt::Error),
@@ -52,6 +37,24 @@ pub enum ReportError {
         source: Box<ReportError>,
     },
 }
+
+// the library's errors below the study come to a report as a study's
+macro_rules! through_study {
+    ($($error:ty),*) => {$(
+        impl From<$error> for ReportError {
+            fn from(e: $error) -> Self {
+                ReportError::Study(e.into())
+            }
+        }
+    )*};
+}
+through_study!(
+    SceneError,
+    SolveError,
+    ContinuationError,
+    StabilityError,
+    AnalysisError
+);
 
 /// A report's result.
 pub type Result<T, E = ReportError> = std::result::Result<T, E>;

@@ -127,8 +127,8 @@ impl Newton {
 
     /// Factor H + shift·I with the smallest shift, from `first`, that makes
     /// it positive definite: after a zero shift 0.1 × `previous` (at least
-    /// 1e-8 × `diag_scale`), then ×10. Returns the shift used.
-    #[allow(clippy::too_many_arguments)]
+    /// 1e-8 × `diag_scale`), then ×10. Returns the shift used (None past
+    /// 1e6 × `diag_scale`), counting the factorisations in `factorizations`.
     fn factor_shifted(
         &mut self,
         energy: &RodEnergy,
@@ -136,21 +136,20 @@ impl Newton {
         first: f64,
         previous: f64,
         diag_scale: f64,
-        report: &mut SolveReport,
-        it: usize,
-    ) -> Result<f64, SolveError> {
+        factorizations: &mut usize,
+    ) -> Option<f64> {
         let mut shift = first;
         loop {
             for &s in &energy.pattern.diagonal {
                 self.values[s] += shift;
             }
-            report.factorizations += 1;
+            *factorizations += 1;
             let ok = ldlt.factor(&self.values).is_ok() && ldlt.negative_count() == 0;
             for &s in &energy.pattern.diagonal {
                 self.values[s] -= shift;
             }
             if ok {
-                return Ok(shift);
+                return Some(shift);
             }
             shift = if shift == 0.0 {
                 (0.1 * previous).max(1e-8 * diag_scale)
@@ -158,10 +157,7 @@ impl Newton {
                 shift * 10.0
             };
             if shift > 1e6 * diag_scale {
-                return Err(SolveError::NonFinite {
-                    step: "Hessian regularisation",
-                    iteration: it,
-                });
+                return None;
             }
         }
     }
@@ -237,15 +233,19 @@ impl Newton {
             // (quadratic convergence near a minimum), after a cut step a
             // larger shift; raise it until H + shift is positive definite
             let previous = shift;
-            shift = self.factor_shifted(
-                energy,
-                ldlt,
-                next_shift,
-                previous,
-                diag_scale,
-                &mut report,
-                it,
-            )?;
+            shift = self
+                .factor_shifted(
+                    energy,
+                    ldlt,
+                    next_shift,
+                    previous,
+                    diag_scale,
+                    &mut report.factorizations,
+                )
+                .ok_or(SolveError::NonFinite {
+                    step: "Hessian regularisation",
+                    iteration: it,
+                })?;
             self.newton_step(energy, ldlt, shift, rel, settings.max_step, it)?;
             let map = energy.map;
             // Armijo backtracking on the energy
