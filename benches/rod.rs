@@ -91,6 +91,7 @@ fn bench(c: &mut Criterion) {
     });
     group("diagnostics_carried", &|_, eq| {
         let (state, previous) = (eq.state.clone(), eq.clone());
+        let measure = measure.clone();
         Box::new(move || {
             Conformation::continued(&state, &measure, &previous);
         })
@@ -100,6 +101,7 @@ fn bench(c: &mut Criterion) {
         let mut newton = Minimizer::new(energy);
         let state = eq.state.clone();
         let previous = eq.clone();
+        let measure = measure.clone();
         Box::new(move || {
             let mut tracer =
                 Tracer::new(&mut newton, Parameter::Phi, ContinuationSettings::default());

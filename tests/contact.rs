@@ -283,7 +283,7 @@ fn trefoil_generator_is_a_trefoil_or_says_why_not() {
     let model = scene.rod_model(None);
     let state = knotrod::study::start::initial_state(&scene, &model).unwrap();
     let shape = knotrod::analysis::equilibrium::Conformation::of(&state, &scene.measure());
-    assert_eq!(shape.knot.determinant, 3);
+    assert_eq!(shape.knot.unwrap().determinant, 3);
     assert!((state.twist() + shape.writhe - 3.0).abs() < 1e-9);
     let err = solve_scene(&Scene::parse(&text(0.3)).unwrap(), None).unwrap_err();
     assert!(

@@ -242,6 +242,41 @@ fn figure_8_strip_branches_at_n_100() {
         good.iter().any(|p| (p - 0.94).abs() <= 0.02),
         "good knots at z* = 0.215: {good:?}"
     );
+    // every good interval of every branch ends at an event of that branch
+    // (walls W1/W2, crossings X, stability S), not between samples
+    use knotrod::study::map::branch_intervals;
+    for z in [0.115, 0.150, 0.180, 0.200, 0.215] {
+        let at_z = |v: f64| (v - z).abs() < 1e-9;
+        let here: Vec<_> = eqs.iter().filter(|e| at_z(e.z_star)).cloned().collect();
+        let here_events: Vec<_> = events.iter().filter(|e| at_z(e.z_star)).cloned().collect();
+        let intervals = branch_intervals(&here, &here_events);
+        assert!(!intervals.is_empty(), "z* = {z}: no good knot");
+        for iv in &intervals {
+            for label in [&iv.lo_label, &iv.hi_label] {
+                assert!(
+                    ["W1", "W2", "X", "S"].contains(&label.as_str()),
+                    "z* = {z}: interval {iv} ends at no event"
+                );
+            }
+        }
+    }
+    // z* = 0.215: the paper's good knot lies between the two crossings X
+    let here: Vec<_> = eqs
+        .iter()
+        .filter(|e| (e.z_star - 0.215).abs() < 1e-9)
+        .cloned()
+        .collect();
+    let here_events: Vec<_> = events
+        .iter()
+        .filter(|e| (e.z_star - 0.215).abs() < 1e-9)
+        .cloned()
+        .collect();
+    let iv = branch_intervals(&here, &here_events);
+    assert!(
+        iv.iter()
+            .any(|i| i.lo_label == "X" && i.hi_label == "X" && i.lo < 0.94 && i.hi > 0.94),
+        "{iv:?}"
+    );
 }
 
 #[test]

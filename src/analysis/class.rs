@@ -1,17 +1,19 @@
-//! The one classifier of an equilibrium, as coloured in the paper's figures:
-//! good knot, stable knotted but not good, unknotted, unstable.
+//! The one classifier of an equilibrium, as coloured in the paper's figures
+//! (good knot, stable knotted but not good, unknotted, unstable), and the one
+//! good-knot predicate every study, plot and recording uses.
 
+use crate::geometry::knot::alexander_of;
 use serde::{Deserialize, Serialize};
 
 /// Class of an equilibrium (or of a point of a map), as coloured in the paper.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum Class {
-    /// A good knot: stable, knotted, walled (and, for `good_knot`, clear of itself).
+    /// A good knot ([`GoodKnot`]).
     Good,
     /// Stable and knotted, not a good knot (not walled, or touching itself).
     StableUnwalled,
-    /// Stable, not knotted.
+    /// Stable, not the asked knot.
     Unknotted,
     /// Unstable.
     Unstable,
@@ -21,10 +23,10 @@ pub enum Class {
 
 impl Class {
     /// The class of an equilibrium that is `stable` or not, whose ray closure
-    /// is a trefoil or not, and that meets the good-knot test or not (a good
-    /// knot is a stable trefoil: `good` only decides among those).
-    pub fn of(stable: bool, trefoil: bool, good: bool) -> Class {
-        match (stable, trefoil, good) {
+    /// is the asked knot or not, and that is a good knot or not (a good knot
+    /// is a stable knot of the asked type: `good` only decides among those).
+    pub fn of(stable: bool, knotted: bool, good: bool) -> Class {
+        match (stable, knotted, good) {
             (false, _, _) => Class::Unstable,
             (true, false, _) => Class::Unknotted,
             (true, true, true) => Class::Good,
@@ -33,24 +35,77 @@ impl Class {
     }
 }
 
-/// The knot determinant of a trefoil, |Δ(−1)| = 3.
-pub const TREFOIL_DETERMINANT: u64 = 3;
+/// The trefoil's Alexander polynomial 1 − t + t².
+pub const TREFOIL: [i64; 3] = [1, -1, 1];
 
-/// Whether a ray closure with this knot determinant is a trefoil.
-pub fn is_trefoil(knot_determinant: u64) -> bool {
-    knot_determinant == TREFOIL_DETERMINANT
+/// Whether a ray closure with this Alexander polynomial is a trefoil.
+pub fn is_trefoil(alexander: &[i64]) -> bool {
+    alexander == TREFOIL
 }
 
-/// The summaries' good knot: walled, an unambiguous trefoil, stable, and no
-/// closer to itself than the rod's diameter. (The maps' boundaries are the
-/// paper's curves: walled, trefoil and stable, the self-distance not asked.)
-pub fn good_knot(
-    walled: bool,
-    trefoil: bool,
-    ambiguous: bool,
-    stable: bool,
-    self_distance: f64,
-    diameter: f64,
-) -> bool {
-    walled && trefoil && !ambiguous && stable && self_distance > diameter
+/// What "contact-free" asks of a good knot.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Clearance {
+    /// The paper's (Sec. 2.2): the centreline does not pass through itself.
+    #[default]
+    Centreline,
+    /// The rod, a tube of its diameter h, does not touch itself: every
+    /// self-distance exceeds h.
+    Diameter,
+}
+
+/// The good-knot predicate: walled ∧ ray closure of the asked knot type ∧
+/// stable ∧ contact-free (by [`Clearance`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GoodKnot {
+    /// The knot asked for, e.g. "3_1" (a tabled knot or a sum, "3_1#4_1").
+    pub knot: String,
+    /// Its Alexander polynomial (the ray closure must have exactly this one).
+    pub alexander: Vec<i64>,
+    /// How far from itself the rod must stay.
+    pub clearance: Clearance,
+    /// The rod's diameter h.
+    pub diameter: f64,
+}
+
+impl GoodKnot {
+    /// The predicate for the knot named `knot`; None if it is not tabled.
+    pub fn new(knot: &str, clearance: Clearance, diameter: f64) -> Option<GoodKnot> {
+        Some(GoodKnot {
+            knot: knot.to_string(),
+            alexander: alexander_of(knot)?,
+            clearance,
+            diameter,
+        })
+    }
+
+    /// The paper's: a trefoil, the centreline clear of itself.
+    pub fn paper(diameter: f64) -> GoodKnot {
+        GoodKnot::new("3_1", Clearance::Centreline, diameter).expect("3_1 is tabled")
+    }
+
+    /// Whether a ray closure with this Alexander polynomial (None: it has no
+    /// knot type) is the asked knot.
+    pub fn is_knot(&self, alexander: Option<&[i64]>) -> bool {
+        alexander == Some(self.alexander.as_slice())
+    }
+
+    /// Whether an equilibrium is a good knot.
+    pub fn holds(&self, walled: bool, knotted: bool, stable: bool, self_distance: f64) -> bool {
+        let clear = match self.clearance {
+            Clearance::Centreline => self_distance > 0.0,
+            Clearance::Diameter => self_distance > self.diameter,
+        };
+        walled && knotted && stable && clear
+    }
+
+    /// The definition in words, for summaries and reports.
+    pub fn describe(&self) -> String {
+        let clear = match self.clearance {
+            Clearance::Centreline => "the centreline clear of itself (the paper's)".to_string(),
+            Clearance::Diameter => format!("no closer to itself than h = {}", self.diameter),
+        };
+        format!("walled, ray closure {}, stable, {clear}", self.knot)
+    }
 }

@@ -1,10 +1,10 @@
 //! One equilibrium of a scene: initial shape, Newton solve, and the quantities
 //! the paper reports (clamp reactions, twist, walls, stability).
 
-use crate::analysis::class::{good_knot, is_trefoil};
+use crate::analysis::class::GoodKnot;
 use crate::geometry::closure::{closure_knot, ray_closure, reach};
 use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
-use crate::geometry::knot::KnotType;
+use crate::geometry::knot::{KnotType, knot_names};
 use crate::geometry::writhe::writhe_closed;
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::linalg::eigen::{Spectrum, StabilityError};
@@ -59,14 +59,18 @@ pub struct Equilibrium {
     pub writhe: f64,
     /// Tw + writhe (for walled configurations the paper's Tw + polar writhe).
     pub link: f64,
-    /// |Δ(−1)| of the ray closure (3: trefoil).
+    /// |Δ(−1)| of the ray closure (3: trefoil; 0 when it has no knot type).
     pub knot_determinant: u64,
     /// Alexander polynomial of the ray closure, lowest degree first.
     pub alexander: Vec<i64>,
-    /// A knot with that polynomial.
+    /// The knots with that polynomial (see [`KnotType::name`]).
     pub knot_name: Option<String>,
-    /// The knot type's projections disagreed.
-    pub knot_ambiguous: bool,
+    /// The ray closure passes through itself: it has no knot type.
+    #[serde(alias = "knot_ambiguous")]
+    pub knot_undefined: bool,
+    /// The ray closure is the knot asked for (`[diagnostics] knot`).
+    #[serde(default)]
+    pub knotted: bool,
     /// Smallest distance between parts of the centreline at least the gap apart.
     pub min_self_distance: f64,
     /// Arc lengths (s, s') of that closest approach.
@@ -75,7 +79,8 @@ pub struct Equilibrium {
     pub wall_distance: f64,
     /// Smallest distance to the clamps' rays (bottom, top), away from the clamps.
     pub ray_distance: [f64; 2],
-    /// Walled, trefoil, stable and no closer to itself than the rod diameter.
+    /// A good knot by the scene's predicate ([`GoodKnot`]): walled, the
+    /// asked knot, stable, contact-free.
     pub good_knot: bool,
     /// Constrained laws: largest |u2| over the vertices (the residual of the
     /// constraint u2 = 0).
@@ -119,12 +124,12 @@ pub struct AnalysisError {
 }
 
 /// Settings of the measurements of an equilibrium.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Measure {
     /// Lowest eigenvalues to compute.
     pub eigenvalues: usize,
-    /// Rod diameter (self-distance threshold of a good knot).
-    pub rod_diameter: f64,
+    /// What a good knot is.
+    pub good: GoodKnot,
     /// Arc-length gap of the self-distance.
     pub self_distance_gap: f64,
     /// Ray length of the writhe closure.
@@ -135,8 +140,8 @@ pub struct Measure {
 pub struct Conformation {
     /// Writhe of the ray closure.
     pub writhe: f64,
-    /// Knot type of the ray closure.
-    pub knot: KnotType,
+    /// Knot type of the ray closure (None: it passes through itself).
+    pub knot: Option<KnotType>,
     /// Closest self-approach.
     pub self_approach: Option<Approach>,
     /// Wall clearance.
@@ -183,7 +188,7 @@ impl Conformation {
         let ray_distance = [ray(&Vector3::zeros(), -e3, 0.0), ray(&end, e3, 1.0)];
         let self_distance = self_approach.map_or(f64::INFINITY, |a| a.distance);
         let carried = previous.filter(|p| {
-            if p.state.nodes.len() != state.nodes.len() || p.knot_ambiguous {
+            if p.state.nodes.len() != state.nodes.len() || p.knot_undefined {
                 return false;
             }
             let moved = p.state.largest_node_distance(state)
@@ -205,19 +210,21 @@ impl Conformation {
                 let turns = (p.link - p.phi_over_2pi).round();
                 (
                     turns + state.clamps.phi_over_2pi() - state.twist(),
-                    KnotType {
+                    Some(KnotType {
                         determinant: p.knot_determinant,
                         alexander: p.alexander.clone(),
                         name: p.knot_name.clone(),
+                        names: knot_names(&p.alexander),
+                        projected: 0,
                         crossings: 0,
-                        directions: 0,
-                        ambiguous: false,
-                    },
+                        vertices: 0,
+                        projections: 0,
+                    }),
                 )
             }
             None => (
                 writhe_closed(&ray_closure(&points, -e3, e3, measure.ray_length)),
-                closure_knot(&points),
+                closure_knot(&points).ok(),
             ),
         };
         Conformation {
@@ -376,6 +383,9 @@ pub fn analyse_from(
     let shape = Conformation::measure(state, measure, previous);
     let twist = state.twist();
     let walled = state.walled();
+    let knotted = measure
+        .good
+        .is_knot(shape.knot.as_ref().map(|k| k.alexander.as_slice()));
     let min_self_distance = shape.self_approach.map_or(f64::INFINITY, |a| a.distance);
     let (max_u2, min_u1, regularised) = strain_checks(newton.energy.model.law, state);
     Ok(Equilibrium {
@@ -399,18 +409,14 @@ pub fn analyse_from(
         stable,
         writhe: shape.writhe,
         link: twist + shape.writhe,
-        knot_determinant: shape.knot.determinant,
-        good_knot: good_knot(
-            walled,
-            is_trefoil(shape.knot.determinant),
-            shape.knot.ambiguous,
-            stable,
-            min_self_distance,
-            measure.rod_diameter,
-        ),
-        alexander: shape.knot.alexander,
-        knot_name: shape.knot.name,
-        knot_ambiguous: shape.knot.ambiguous,
+        knot_determinant: shape.knot.as_ref().map_or(0, |k| k.determinant),
+        knotted,
+        good_knot: measure
+            .good
+            .holds(walled, knotted, stable, min_self_distance),
+        knot_undefined: shape.knot.is_none(),
+        alexander: shape.knot.as_ref().map_or(vec![], |k| k.alexander.clone()),
+        knot_name: shape.knot.and_then(|k| k.name),
         min_self_distance,
         min_self_distance_s: shape.self_approach.map_or([f64::NAN; 2], |a| a.s),
         wall_distance: shape.wall_distance,

@@ -1,11 +1,11 @@
 //! `knotrod knot`: writhe and knot type of any curve.
 
 use crate::geometry::closure::{extent, ray_closure};
-use crate::geometry::knot::{KnotType, knot_type};
+use crate::geometry::knot::{KnotError, KnotType, knot_type};
 use crate::geometry::writhe::writhe_closed;
 use crate::io::curve_file::read_points;
 use crate::io::json::write_pretty;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -23,6 +23,7 @@ pub enum RayKind {
 pub fn knot(path: &Path, closed: bool, rays: RayKind, json: Option<PathBuf>) -> Result<()> {
     let points = read_points(path)?;
     let (writhe, kt) = writhe_and_knot(&points, closed, rays);
+    let kt = kt.with_context(|| format!("knot type of {}", path.display()))?;
     let answer = serde_json::json!({
         "curve": path.display().to_string(),
         "points": points.len(),
@@ -31,9 +32,10 @@ pub fn knot(path: &Path, closed: bool, rays: RayKind, json: Option<PathBuf>) -> 
         "knot_determinant": kt.determinant,
         "alexander": kt.alexander,
         "knot_name": kt.name,
+        "knot_names": kt.names,
         "crossings": kt.crossings,
-        "projections": kt.directions,
-        "ambiguous": kt.ambiguous,
+        "vertices_simplified": kt.vertices,
+        "projections": kt.projections,
     });
     let mut out = std::io::stdout().lock();
     match json {
@@ -57,7 +59,11 @@ pub fn knot(path: &Path, closed: bool, rays: RayKind, json: Option<PathBuf>) -> 
 }
 
 /// Writhe and knot type of a closed curve, or of an open one closed by rays.
-fn writhe_and_knot(points: &[Vector3<f64>], closed: bool, rays: RayKind) -> (f64, KnotType) {
+fn writhe_and_knot(
+    points: &[Vector3<f64>],
+    closed: bool,
+    rays: RayKind,
+) -> (f64, Result<KnotType, KnotError>) {
     if closed {
         return (writhe_closed(points), knot_type(points));
     }
@@ -86,19 +92,23 @@ fn print_knot(head: &str, writhe: f64, kt: &KnotType, out: &mut impl Write) -> R
     writeln!(out, "  writhe {writhe:.6}")?;
     writeln!(out, "  knot determinant {}", kt.determinant)?;
     writeln!(out, "  Alexander polynomial {}", polynomial(&kt.alexander))?;
+    match kt.names.as_slice() {
+        [] => writeln!(
+            out,
+            "  knot: none of the tabled ones (prime knots to 10 crossings and their sums)"
+        )?,
+        [one] => writeln!(out, "  knot {one}")?,
+        many => writeln!(
+            out,
+            "  knot one of {} (they share this polynomial)",
+            many.join(", ")
+        )?,
+    }
     writeln!(
         out,
-        "  likely knot {}",
-        kt.name
-            .as_deref()
-            .unwrap_or("not in the table (more than 7 crossings?)")
+        "  ({} crossings in the reduced diagram, {} vertices after simplification)",
+        kt.crossings, kt.vertices
     )?;
-    if kt.ambiguous {
-        writeln!(
-            out,
-            "  AMBIGUOUS: projections disagree or are degenerate (the curve may pass through itself)"
-        )?;
-    }
     Ok(())
 }
 

@@ -50,7 +50,9 @@ pub fn reach(points: &[Vector3<f64>]) -> f64 {
 
 /// Knot type of the closure by rays along −e3 from the first point and +e3
 /// from the last (the paper's closure of a clamped rod).
-pub fn closure_knot(points: &[Vector3<f64>]) -> crate::geometry::knot::KnotType {
+pub fn closure_knot(
+    points: &[Vector3<f64>],
+) -> Result<crate::geometry::knot::KnotType, crate::geometry::knot::KnotError> {
     let e3 = Vector3::z();
     crate::geometry::knot::knot_type(&ray_closure(points, -e3, e3, reach(points)))
 }

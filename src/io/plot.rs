@@ -4,7 +4,7 @@
 //! and the minimum self-distance along the branches. SVG always; PNG when a
 //! TrueType font is found for the labels.
 
-use crate::analysis::class::{Class, is_trefoil};
+use crate::analysis::class::Class;
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
 use crate::io::error::{IoError, Result};
@@ -12,13 +12,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// The colour of an equilibrium's class (summaries' good knot).
+/// The colour of an equilibrium's class.
 pub fn class_colour(e: &Equilibrium) -> RGBColor {
-    colour_of(Class::of(
-        e.stable,
-        is_trefoil(e.knot_determinant),
-        e.good_knot,
-    ))
+    colour_of(Class::of(e.stable, e.knotted, e.good_knot))
 }
 
 /// The paper's colour of a class.

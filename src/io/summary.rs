@@ -146,7 +146,11 @@ pub fn print_equilibrium(
             .as_deref()
             .map(|n| format!(" — {n}"))
             .unwrap_or_default(),
-        if e.knot_ambiguous { " (AMBIGUOUS)" } else { "" }
+        if e.knot_undefined {
+            " (none: the ray closure passes through itself)"
+        } else {
+            ""
+        }
     )?;
     writeln!(
         out,

@@ -99,6 +99,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
     let fig7 = Scene::load(&scenes.join("fig7_island_kirchhoff.toml"))?;
     let mut workloads = branch_workloads(&d, &fig3)?;
     workloads.extend(island_workloads(&fig7)?);
+    workloads.push(dense_knot_workload()?);
     // per-operation costs on the Appendix D knot resampled at each N
     let mut per: BTreeMap<String, Vec<(usize, f64)>> = BTreeMap::new();
     for n in [200, 400, 800, 1600, 3200] {
@@ -272,7 +273,7 @@ fn geometry_costs(
     push(
         "knot_type_at_passages",
         per_call(|| {
-            knot_type(&short);
+            let _ = knot_type(&short);
         }),
     );
     push(
@@ -296,6 +297,42 @@ fn geometry_costs(
             Conformation::of(state, &m);
         }),
     );
+}
+
+/// The knot type of 10⁵ points on the torus knot T(3,5) = 10_124, each
+/// moved by up to 10⁻⁴ (a deterministic jitter): simplification, diagram and
+/// exact polynomial; an error if the answer is not T(3,5)'s.
+fn dense_knot_workload() -> Result<Workload> {
+    let m = 100_000;
+    let mut seed: u64 = 41;
+    let mut jitter = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * 1e-4
+    };
+    let points: Vec<nalgebra::Vector3<f64>> = (0..m)
+        .map(|k| {
+            let t = 2.0 * std::f64::consts::PI * k as f64 / m as f64;
+            let r = 2.0 + (5.0 * t).cos();
+            nalgebra::Vector3::new(
+                r * (3.0 * t).cos() + jitter(),
+                r * (3.0 * t).sin() + jitter(),
+                (5.0 * t).sin() + jitter(),
+            )
+        })
+        .collect();
+    timed("knot_type_of_100000_points", m, || {
+        let k = knot_type(&points)
+            .map_err(|e| crate::report::error::ReportError::Failed(format!("T(3,5): {e}")))?;
+        if k.alexander != [1, -1, 0, 1, -1, 1, 0, -1, 1] {
+            return Err(crate::report::error::ReportError::Failed(format!(
+                "T(3,5) of 10⁵ points read as {:?}",
+                k.alexander
+            )));
+        }
+        Ok(())
+    })
 }
 
 /// Print a report as tables.

@@ -8,6 +8,7 @@ mod validate;
 
 pub use map::{MapSpec, SliceSpec};
 
+use crate::analysis::class::{Clearance, GoodKnot};
 use crate::analysis::equilibrium::Measure;
 use crate::model::contact::ContactModel;
 use crate::model::rod::{Clamps, Law, Parameter, RodModel, RodState};
@@ -321,6 +322,13 @@ pub struct DiagnosticsSpec {
     pub self_distance_gap: f64,
     /// Length of the rays closing the curve for the writhe (its error ∝ 1/length).
     pub ray_length: f64,
+    /// The knot a good knot's ray closure must be: a tabled knot ("3_1",
+    /// "4_1", … up to 10 crossings) or a sum of them ("3_1#3_1").
+    pub knot: String,
+    /// What "contact-free" asks of a good knot: "centreline" (the paper's:
+    /// the centreline does not pass through itself) or "diameter" (every
+    /// self-distance above the rod's diameter).
+    pub clearance: Clearance,
 }
 
 impl Default for DiagnosticsSpec {
@@ -328,6 +336,8 @@ impl Default for DiagnosticsSpec {
         DiagnosticsSpec {
             self_distance_gap: 0.05,
             ray_length: 1e6,
+            knot: "3_1".into(),
+            clearance: Clearance::Centreline,
         }
     }
 }
@@ -504,11 +514,19 @@ impl Scene {
         })
     }
 
+    /// Its good-knot predicate (the knot was checked by validation; an
+    /// untabled one falls back to the paper's trefoil).
+    pub fn good_knot(&self) -> GoodKnot {
+        let d = &self.diagnostics;
+        GoodKnot::new(&d.knot, d.clearance, self.model.rod_diameter)
+            .unwrap_or_else(|| GoodKnot::paper(self.model.rod_diameter))
+    }
+
     /// The measurement settings of its equilibria.
     pub fn measure(&self) -> Measure {
         Measure {
             eigenvalues: self.stability.eigenvalues as usize,
-            rod_diameter: self.model.rod_diameter,
+            good: self.good_knot(),
             self_distance_gap: self.diagnostics.self_distance_gap,
             ray_length: self.diagnostics.ray_length,
         }

@@ -284,6 +284,25 @@ impl Scene {
             ));
         }
         positive("diagnostics.ray_length", d.ray_length)?;
+        match crate::geometry::knot::alexander_of(&d.knot) {
+            None => {
+                return Err(SceneError::Invalid {
+                    field: "diagnostics.knot",
+                    reason: format!(
+                        "\"{}\" is not a tabled knot: name a prime knot up to 10 crossings \
+                         as \"3_1\" … \"10_165\", or a sum of them as \"3_1#4_1\"",
+                        d.knot
+                    ),
+                });
+            }
+            Some(p) if p == [1] => {
+                return Err(SceneError::Invalid {
+                    field: "diagnostics.knot",
+                    reason: "a good knot must be knotted: the unknot 0_1 is not one".into(),
+                });
+            }
+            Some(_) => {}
+        }
         Ok(())
     }
 

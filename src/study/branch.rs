@@ -15,7 +15,7 @@ use crate::study::error::{Context, Result};
 #[derive(Clone, Debug)]
 struct TestValues {
     wall: f64,
-    knot: u64,
+    knot: Vec<i64>,
     link: f64,
 }
 
@@ -23,16 +23,30 @@ impl TestValues {
     fn of(eq: &Equilibrium) -> TestValues {
         TestValues {
             wall: eq.wall_distance,
-            knot: eq.knot_determinant,
+            knot: eq.alexander.clone(),
             link: eq.link,
         }
     }
 }
 
-/// Knot determinant and link of a state.
-fn knot_of(state: &RodState, measure: &Measure) -> (u64, f64) {
+/// Alexander polynomial (empty: no knot type) and link of a state.
+fn knot_of(state: &RodState, measure: &Measure) -> (Vec<i64>, f64) {
     let shape = Conformation::of(state, measure);
-    (shape.knot.determinant, state.twist() + shape.writhe)
+    let knot = shape.knot.map_or(vec![], |k| k.alexander);
+    (knot, state.twist() + shape.writhe)
+}
+
+/// A knot for event details: its name, else its Alexander polynomial.
+fn knot_label(alexander: &[i64]) -> String {
+    if alexander.is_empty() {
+        return "none".into();
+    }
+    let names = crate::geometry::knot::knot_names(alexander);
+    if names.is_empty() {
+        format!("Δ = {alexander:?}")
+    } else {
+        names.join(" or ")
+    }
 }
 
 /// What the caller gets for every accepted point.
@@ -337,8 +351,8 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         ds: f64,
         branch: usize,
     ) -> Result<()> {
-        let measure = self.options.measure;
-        let (ka, la) = (wa.knot, wa.link);
+        let measure = self.options.measure.clone();
+        let (ka, la) = (wa.knot.clone(), wa.link);
         let p = self
             .locate(a, ds, &mut |_, p| {
                 let (knot, link) = knot_of(&p.state, &measure);
@@ -346,8 +360,11 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             })
             .context("locating a crossing")?;
         let detail = format!(
-            "knot determinant {} → {}, link {:.3} → {:.3}",
-            wa.knot, wb.knot, wa.link, wb.link
+            "knot {} → {}, link {:.3} → {:.3}",
+            knot_label(&wa.knot),
+            knot_label(&wb.knot),
+            wa.link,
+            wb.link
         );
         self.events
             .push(event(EventKind::Crossing, &p, branch, detail.clone()));

@@ -6,7 +6,7 @@
 //! the boundary curves. Maps shard (`--shard i/n`, `knotrod merge`) and resume
 //! from the lines already written.
 
-use crate::analysis::class::{Class, is_trefoil};
+use crate::analysis::class::Class;
 use crate::analysis::equilibrium::{Equilibrium, Measure};
 use crate::analysis::event::{Event, EventKind};
 use crate::scene::{MapSpec, Scene, SliceSpec};
@@ -164,12 +164,22 @@ pub fn assemble_3d(scene: &str, spec: &SliceSpec, slices: Vec<Map>) -> Map3 {
     }
 }
 
-/// Points ordered along the branch (second leg reversed, then the first).
-fn ordered(eqs: &[Equilibrium]) -> Vec<&Equilibrium> {
-    let mut down: Vec<&Equilibrium> = eqs.iter().filter(|e| e.branch == 0 && e.leg == 1).collect();
+/// The classified points of the first branch of a run (the lowest branch
+/// number), in order along it (second leg reversed, then the first).
+pub fn line_points(eqs: &[Equilibrium]) -> Vec<LinePoint> {
+    let first = eqs.iter().map(|e| e.branch).min().unwrap_or(0);
+    let mut down: Vec<&Equilibrium> = eqs
+        .iter()
+        .filter(|e| e.branch == first && e.leg == 1)
+        .collect();
     down.reverse();
     down.into_iter()
-        .chain(eqs.iter().filter(|e| e.branch == 0 && e.leg == 0))
+        .chain(eqs.iter().filter(|e| e.branch == first && e.leg == 0))
+        .map(|e| LinePoint {
+            phi_over_2pi: e.phi_over_2pi,
+            twist: e.twist,
+            class: Class::of(e.stable, e.knotted, e.good_knot),
+        })
         .collect()
 }
 
@@ -188,14 +198,14 @@ fn boundary_label(events: &[Event], p: &LinePoint, q: &LinePoint, lower: bool) -
     let best = events
         .iter()
         .filter(|e| {
-            e.branch == 0
-                && matches!(
-                    e.kind,
-                    EventKind::Wall
-                        | EventKind::Crossing
-                        | EventKind::BranchPoint
-                        | EventKind::Fold
-                )
+            matches!(
+                e.kind,
+                EventKind::Wall
+                    | EventKind::Crossing
+                    | EventKind::BranchPoint
+                    | EventKind::Fold
+                    | EventKind::Stability
+            )
         })
         // the event lies on the arc between the two points: near their chord
         .filter(|e| dist(e) <= 0.3 * scale + 1e-9)
@@ -215,8 +225,20 @@ fn boundary_label(events: &[Event], p: &LinePoint, q: &LinePoint, lower: bool) -
     }
 }
 
+/// Good intervals along the first branch of a run (see [`line_points`]),
+/// each bounded by that branch's events.
+pub fn branch_intervals(eqs: &[Equilibrium], events: &[Event]) -> Vec<Interval> {
+    let first = eqs.iter().map(|e| e.branch).min().unwrap_or(0);
+    let on: Vec<Event> = events
+        .iter()
+        .filter(|e| e.branch == first)
+        .cloned()
+        .collect();
+    intervals_of(&line_points(eqs), &on)
+}
+
 /// Good intervals of a line: maximal runs of good points, bounded by the
-/// events between their ends and the neighbouring points.
+/// events (of the same branch) between their ends and the neighbouring points.
 pub fn intervals_of(points: &[LinePoint], events: &[Event]) -> Vec<Interval> {
     let mut intervals = Vec::new();
     let good: Vec<bool> = points.iter().map(|p| p.class == Class::Good).collect();
@@ -280,16 +302,8 @@ pub fn line(scene: &Scene, spec: &MapSpec, index: usize, segments: Option<usize>
     };
     match compute_line(scene, spec, value, segments) {
         Ok((eqs, events)) => {
-            let ord = ordered(&eqs);
-            out.points = ord
-                .iter()
-                .map(|e| LinePoint {
-                    phi_over_2pi: e.phi_over_2pi,
-                    twist: e.twist,
-                    class: Class::of(e.stable, is_trefoil(e.knot_determinant), e.walled),
-                })
-                .collect();
-            out.intervals = intervals_of(&out.points, &events);
+            out.points = line_points(&eqs);
+            out.intervals = branch_intervals(&eqs, &events);
             out.events = events;
         }
         Err(e) => out.error = Some(describe(&e)),

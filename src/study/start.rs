@@ -84,14 +84,15 @@ fn trefoil(scene: &Scene, n: usize, clamps: Clamps) -> Result<RodState> {
     };
     set(&mut state, 0.0);
     let shape = Conformation::of(&state, &scene.measure());
-    if !is_trefoil(shape.knot.determinant) {
+    let alexander = shape.knot.as_ref().map(|k| k.alexander.clone());
+    if !alexander.as_deref().is_some_and(is_trefoil) {
         return Err(SceneError::Invalid {
             field: "initial.shape",
             reason: format!(
                 "\"trefoil\": at z* = {}, δ = {} the guide curve's ray closure is \
-                 not a trefoil (knot determinant {}); start from the paper's clamps \
+                 not a trefoil (Alexander polynomial {:?}); start from the paper's clamps \
                  (z* ≈ 0.115, δ ≈ 0.05) and load from there",
-                clamps.z_star, clamps.delta, shape.knot.determinant
+                clamps.z_star, clamps.delta, alexander
             ),
         }
         .into());

@@ -1,7 +1,7 @@
 //! The recording's topics and its JSON messages (scalars for plots, the
 //! full state for restarts), with their schemas.
 
-use crate::analysis::class::{Class, is_trefoil};
+use crate::analysis::class::Class;
 use crate::analysis::equilibrium::Equilibrium;
 use crate::io::plot::{PlotPoint, colour_of};
 use crate::model::rod::{RodModel, RodState};
@@ -43,6 +43,10 @@ pub struct Scalars {
     pub link: f64,
     /// |Δ(−1)|.
     pub knot_determinant: u64,
+    /// The ray closure is the scene's good-knot type (absent in recordings
+    /// before it was kept: read as a trefoil by determinant 3).
+    #[serde(default)]
+    pub knotted: Option<bool>,
     /// Lowest interior z.
     pub min_z: f64,
     /// Highest interior z.
@@ -94,6 +98,7 @@ impl Scalars {
             writhe: e.writhe,
             link: e.link,
             knot_determinant: e.knot_determinant,
+            knotted: Some(e.knotted),
             min_z: e.min_z,
             max_z: e.max_z,
             wall_distance: e.wall_distance,
@@ -120,7 +125,7 @@ pub struct StateMessage {
     pub state: RodState,
 }
 
-pub(super) const SCALARS_SCHEMA: &str = r#"{"title":"knotrod.Scalars","type":"object","properties":{"index":{"type":"integer"},"branch":{"type":"integer"},"leg":{"type":"integer"},"z_star":{"type":"number"},"delta":{"type":"number"},"phi_over_2pi":{"type":"number"},"energy":{"type":"number"},"twist":{"type":"number"},"writhe":{"type":"number"},"link":{"type":"number"},"knot_determinant":{"type":"integer"},"min_z":{"type":"number"},"max_z":{"type":"number"},"wall_distance":{"type":"number"},"min_self_distance":{"type":"number"},"lowest_eigenvalue":{"type":"number"},"lowest_omega_squared":{"type":"number"},"negative_eigenvalues":{"type":"integer"},"stable":{"type":"boolean"},"good_knot":{"type":"boolean"},"iterations":{"type":"integer"},"contact_force":{"type":"number"}}}"#;
+pub(super) const SCALARS_SCHEMA: &str = r#"{"title":"knotrod.Scalars","type":"object","properties":{"index":{"type":"integer"},"branch":{"type":"integer"},"leg":{"type":"integer"},"z_star":{"type":"number"},"delta":{"type":"number"},"phi_over_2pi":{"type":"number"},"energy":{"type":"number"},"twist":{"type":"number"},"writhe":{"type":"number"},"link":{"type":"number"},"knot_determinant":{"type":"integer"},"knotted":{"type":"boolean"},"min_z":{"type":"number"},"max_z":{"type":"number"},"wall_distance":{"type":"number"},"min_self_distance":{"type":"number"},"lowest_eigenvalue":{"type":"number"},"lowest_omega_squared":{"type":"number"},"negative_eigenvalues":{"type":"integer"},"stable":{"type":"boolean"},"good_knot":{"type":"boolean"},"iterations":{"type":"integer"},"contact_force":{"type":"number"}}}"#;
 pub(super) const STATE_SCHEMA: &str = r#"{"title":"knotrod.RodState","type":"object","properties":{"index":{"type":"integer"},"model":{"type":"object"},"state":{"type":"object","properties":{"clamps":{"type":"object"},"nodes":{"type":"array"},"theta":{"type":"array"},"reference":{"type":"array"},"reference_twist":{"type":"array"}}}}}"#;
 pub(super) const EVENT_SCHEMA: &str = r#"{"title":"knotrod.Event","type":"object","properties":{"kind":{"type":"string"},"label":{"type":"string"},"phi_over_2pi":{"type":"number"},"z_star":{"type":"number"},"delta":{"type":"number"},"twist":{"type":"number"},"branch":{"type":"integer"},"detail":{"type":"string"}}}"#;
 
@@ -133,7 +138,7 @@ impl From<&Scalars> for PlotPoint {
             stable: e.stable,
             colour: colour_of(Class::of(
                 e.stable,
-                is_trefoil(e.knot_determinant),
+                e.knotted.unwrap_or(e.knot_determinant == 3),
                 e.good_knot,
             )),
             omega_squared: Some(e.lowest_omega_squared).filter(|v| v.is_finite()),

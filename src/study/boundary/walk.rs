@@ -2,7 +2,6 @@
 //! pseudo-arclength continuation in the plane, corners where another property
 //! fails, equilibria by Newton at fixed clamps.
 
-use crate::analysis::class::is_trefoil;
 use crate::analysis::equilibrium::Measure;
 use crate::geometry::closure::closure_knot;
 use crate::model::rod::{Clamps, Parameter, RodState};
@@ -221,7 +220,11 @@ impl Walk<'_, '_> {
         if skip != Some(Failure::Stability) && site.point.negative_count > 0 {
             return Ok(Some(Failure::Stability));
         }
-        let trefoil = |s: &RodState| is_trefoil(closure_knot(&s.centreline().0).determinant);
+        let good = self.measure.good.clone();
+        let trefoil = |s: &RodState| {
+            let knot = closure_knot(&s.centreline().0).ok();
+            good.is_knot(knot.as_ref().map(|k| k.alexander.as_slice()))
+        };
         let knotted = if skip == Some(Failure::Knot) {
             let off = self.equilibrium_at(site, along(site.p, normal, FD))?;
             trefoil(&off.point.state)
