@@ -23,6 +23,25 @@ fn appendix_d_is_a_good_knot_with_the_papers_link() {
 }
 
 #[test]
+fn the_good_knot_predicate_follows_the_scene() {
+    use knotrod::analysis::class::{Clearance, GoodKnot};
+    let mut scene = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
+    scene.diagnostics.knot = "4_1".into();
+    let e = solve_scene(&scene, Some(100)).unwrap();
+    assert!(e.walled && e.stable && !e.knotted && !e.good_knot);
+    // the paper's clearance asks only that the centreline miss itself; the
+    // diameter clearance asks the self-distance to exceed h
+    let d = e.min_self_distance;
+    let paper = GoodKnot::new("3_1", Clearance::Centreline, 2.0 * d).unwrap();
+    let thick = GoodKnot::new("3_1", Clearance::Diameter, 2.0 * d).unwrap();
+    let thin = GoodKnot::new("3_1", Clearance::Diameter, 0.5 * d).unwrap();
+    assert!(paper.holds(true, true, true, d) && thin.holds(true, true, true, d));
+    assert!(!thick.holds(true, true, true, d));
+    assert!(!paper.holds(true, true, true, 0.0));
+    assert!(paper.describe().contains("paper") && thick.describe().contains("h ="));
+}
+
+#[test]
 fn appendix_e_is_knotted_but_not_walled() {
     let scene = Scene::load(Path::new("scenes/appendix_e.toml")).unwrap();
     let e = solve_scene(&scene, Some(200)).unwrap();
@@ -106,4 +125,36 @@ fn writhe_carried_along_a_branch_equals_the_full_writhe() {
     }
     // the full writhe closes the rays at length 1e6: it differs by O(1e-6)
     assert!(largest < 1e-5, "largest writhe difference {largest:e}");
+    // step by step, as the branch measured them: across the crossing X the
+    // writhe comes from the exact ±2 jump, and it equals the full one
+    use knotrod::analysis::equilibrium::Measured;
+    let (mut passages, mut jumps) = (0, 0);
+    for pair in eqs.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        if a.branch != b.branch || a.leg != b.leg {
+            continue;
+        }
+        let step = Conformation::continued(&b.state, &measure, a);
+        let full = Conformation::of(&b.state, &measure);
+        assert!(
+            (step.writhe - full.writhe).abs() < 1e-5,
+            "φ/2π = {}: {:?} writhe {} vs full {}",
+            b.phi_over_2pi,
+            step.how,
+            step.writhe,
+            full.writhe
+        );
+        assert_eq!(
+            step.knot.map(|k| k.alexander),
+            full.knot.map(|k| k.alexander)
+        );
+        if step.how == Measured::Passage {
+            passages += 1;
+            jumps += usize::from((b.writhe - a.writhe).abs() > 1.0);
+        }
+    }
+    assert!(
+        passages >= 1 && jumps >= 1,
+        "{passages} passages, {jumps} jumps"
+    );
 }

@@ -77,7 +77,26 @@ fn bad_scenes_name_the_field() {
             format!("{GOOD}{MAP}trace_from = [0.1, nan]\n"),
             "map.trace_from",
         ),
+        (
+            format!("{GOOD}\n[diagnostics]\nknot = \"12a_1\"\n"),
+            "diagnostics.knot",
+        ),
+        (
+            format!("{GOOD}\n[diagnostics]\nknot = \"0_1\"\n"),
+            "diagnostics.knot",
+        ),
+        (
+            format!("{GOOD}\n[diagnostics]\nclearance = \"touching\"\n"),
+            "clearance",
+        ),
+        (
+            format!("{GOOD}{MAP}\n[diagnostics]\nclearance = \"diameter\"\n"),
+            "diagnostics.clearance",
+        ),
     ];
+    // a tabled knot or a sum of them is accepted
+    let sum = Scene::parse(&format!("{GOOD}\n[diagnostics]\nknot = \"3_1#4_1\"\n")).unwrap();
+    assert_eq!(sum.good_knot().alexander, vec![-1, 4, -5, 4, -1]);
     for (text, field) in cases {
         let msg = error_of(&text);
         assert!(

@@ -3,7 +3,9 @@
 
 use crate::analysis::class::GoodKnot;
 use crate::geometry::closure::{closure_knot, ray_closure, reach};
-use crate::geometry::distance::{Approach, distance_to_ray, min_self_distance};
+use crate::geometry::distance::{
+    Approach, CurveTree, distance_to_ray, min_self_distance, strand_side,
+};
 use crate::geometry::knot::{KnotType, knot_names};
 use crate::geometry::writhe::writhe_closed;
 use crate::linalg::eigen::lowest_eigenvalues;
@@ -148,6 +150,21 @@ pub struct Conformation {
     pub wall_distance: f64,
     /// Distances to the bottom and top rays.
     pub ray_distance: [f64; 2],
+    /// How the writhe and knot type were obtained.
+    pub how: Measured,
+}
+
+/// How a conformation's writhe and knot type were obtained.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Measured {
+    /// Computed afresh: the O(N²) writhe, the knot type.
+    Full,
+    /// Carried from the previous point: no strand came near another.
+    Carried,
+    /// Across one passage of two strands (or none) from the previous point:
+    /// the link's integer part jumps by the passage's ±2, the knot type is
+    /// recomputed if they passed.
+    Passage,
 }
 
 impl Conformation {
@@ -205,26 +222,43 @@ impl Conformation {
             .fold(f64::INFINITY, f64::min);
             clearance > 2.0 * moved
         });
-        let (writhe, knot) = match carried {
-            Some(p) => {
-                let turns = (p.link - p.phi_over_2pi).round();
-                (
-                    turns + state.clamps.phi_over_2pi() - state.twist(),
-                    Some(KnotType {
-                        determinant: p.knot_determinant,
-                        alexander: p.alexander.clone(),
-                        name: p.knot_name.clone(),
-                        names: knot_names(&p.alexander),
-                        projected: 0,
-                        crossings: 0,
-                        vertices: 0,
-                        projections: 0,
-                    }),
-                )
+        let kept = |p: &Equilibrium| {
+            Some(KnotType {
+                determinant: p.knot_determinant,
+                alexander: p.alexander.clone(),
+                name: p.knot_name.clone(),
+                names: knot_names(&p.alexander),
+                projected: 0,
+                crossings: 0,
+                vertices: 0,
+                projections: 0,
+            })
+        };
+        // Wr = n + φ/2π − Tw with n the link's integer part, carried
+        let writhe_with = |p: &Equilibrium, jump: f64| {
+            (p.link - p.phi_over_2pi).round() + jump + state.clamps.phi_over_2pi() - state.twist()
+        };
+        let passage = match (carried, previous, self_approach) {
+            (None, Some(p), Some(a)) => {
+                passage_jump(state, &points, &arc, p, &a, ray_distance, gap).map(|j| (p, j))
             }
-            None => (
+            _ => None,
+        };
+        let (writhe, knot, how) = match (carried, passage) {
+            (Some(p), _) => (writhe_with(p, 0.0), kept(p), Measured::Carried),
+            (None, Some((p, jump))) => (
+                writhe_with(p, jump),
+                if jump == 0.0 {
+                    kept(p)
+                } else {
+                    closure_knot(&points).ok()
+                },
+                Measured::Passage,
+            ),
+            (None, None) => (
                 writhe_closed(&ray_closure(&points, -e3, e3, measure.ray_length)),
                 closure_knot(&points).ok(),
+                Measured::Full,
             ),
         };
         Conformation {
@@ -233,8 +267,75 @@ impl Conformation {
             self_approach,
             wall_distance,
             ray_distance,
+            how,
         }
     }
+}
+
+/// The jump of the writhe from the measured equilibrium `p` to `state`
+/// (−2, 0 or +2) when the only strands that can have passed through each
+/// other are the two at the closest approach `a`: the rays clear before and
+/// after by twice the largest move, every close pair of segments (within
+/// that distance) in both states near the pair at `a`, and on both sides a
+/// clear signed gap between the strands. Passing from the side σ to −σ
+/// changes the local Gauss integral sign((t₀ × t₁)·(r₀ − r₁)) from sign σ
+/// to −sign σ, so Wr jumps by −2 sign σ. None where this cannot be told
+/// (the caller computes the writhe afresh).
+fn passage_jump(
+    state: &RodState,
+    points: &[Vector3<f64>],
+    arc: &[f64],
+    p: &Equilibrium,
+    a: &Approach,
+    ray_distance: [f64; 2],
+    gap: f64,
+) -> Option<f64> {
+    if p.state.nodes.len() != state.nodes.len() || p.knot_undefined {
+        return None;
+    }
+    let moved = p.state.largest_node_distance(state)
+        + (p.state.clamps.end_point() - state.clamps.end_point()).norm();
+    let rays = [
+        ray_distance[0],
+        ray_distance[1],
+        p.ray_distance[0],
+        p.ray_distance[1],
+    ]
+    .into_iter()
+    .fold(f64::INFINITY, f64::min);
+    if rays <= 2.0 * moved {
+        return None;
+    }
+    let (before, before_arc) = p.state.centreline();
+    let h = arc[1] - arc[0];
+    let radius = 4.0 * moved + 3.0 * h;
+    let local = |pts: &[Vector3<f64>], arc: &[f64]| {
+        CurveTree::new(pts)
+            .pairs_within(arc, gap, 2.0 * moved)
+            .into_iter()
+            .all(|(i, j)| (arc[i] - a.s[0]).abs() <= radius && (arc[j] - a.s[1]).abs() <= radius)
+    };
+    if !local(points, arc) || !local(&before, &before_arc) {
+        return None;
+    }
+    let previous_approach = min_self_distance(&before, &before_arc, gap)?;
+    let near =
+        |b: &Approach| (b.s[0] - a.s[0]).abs() <= radius && (b.s[1] - a.s[1]).abs() <= radius;
+    if !near(&previous_approach) {
+        return None;
+    }
+    // the same chords in both states orient the normal alike
+    let side_now = strand_side(points, arc, a.s, a.segments)?;
+    let side_before = strand_side(&before, &before_arc, previous_approach.s, a.segments)?;
+    // a gap mostly along the normal: the strands are locally straight there
+    if side_now.abs() < 0.5 * a.distance || side_before.abs() < 0.5 * previous_approach.distance {
+        return None;
+    }
+    Some(if side_now.signum() == side_before.signum() {
+        0.0
+    } else {
+        -2.0 * side_before.signum()
+    })
 }
 
 /// The Hessian with the contacts held: for each contact row carrying force z

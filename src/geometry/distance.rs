@@ -266,3 +266,31 @@ pub fn distance_to_ray(
     }
     best
 }
+
+/// The point at arc length `s` of the polyline (`arc[k]` is point k's).
+pub fn point_at(points: &[Vector3<f64>], arc: &[f64], s: f64) -> Vector3<f64> {
+    let k = arc.partition_point(|&a| a <= s).clamp(1, arc.len() - 1) - 1;
+    let t = ((s - arc[k]) / (arc[k + 1] - arc[k])).clamp(0.0, 1.0);
+    points[k] + t * (points[k + 1] - points[k])
+}
+
+/// Which side of each other two strands pass: at arc lengths s[0] < s[1],
+/// the gap between their points along the normal n = c₀ × c₁ of the local
+/// strand directions, each the chord over a few segments around segment
+/// `around[i]` (oriented with s). Its sign flips exactly when the strands
+/// pass through each other; None where the strands are parallel.
+pub fn strand_side(
+    points: &[Vector3<f64>],
+    arc: &[f64],
+    s: [f64; 2],
+    around: [usize; 2],
+) -> Option<f64> {
+    let last = points.len() - 1;
+    let chord = |k: usize| points[(k + 3).min(last)] - points[k.saturating_sub(2)];
+    let n = chord(around[0]).cross(&chord(around[1]));
+    let len = n.norm();
+    if len <= 1e-12 * chord(around[0]).norm() * chord(around[1]).norm() {
+        return None;
+    }
+    Some((point_at(points, arc, s[0]) - point_at(points, arc, s[1])).dot(&n) / len)
+}

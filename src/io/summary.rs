@@ -32,6 +32,9 @@ pub struct Summary {
     pub model: ModelSummary,
     /// N.
     pub segments: usize,
+    /// What `good_knot` means in this summary (the scene's `[diagnostics]`).
+    #[serde(default)]
+    pub good_knot: String,
     /// Equilibria in the order computed.
     pub equilibria: Vec<Equilibrium>,
     /// Located events (filled by continuation runs).
@@ -50,6 +53,7 @@ impl Summary {
                 stretching_stiffness: model.stretching_stiffness,
             },
             segments: model.segments,
+            good_knot: scene.good_knot().describe(),
             equilibria: Vec::new(),
             events: Vec::new(),
         }
@@ -164,8 +168,9 @@ pub fn print_equilibrium(
     )?;
     writeln!(
         out,
-        "  good knot: {}",
-        if e.good_knot { "YES" } else { "no" }
+        "  good knot: {} ({})",
+        if e.good_knot { "YES" } else { "no" },
+        scene.good_knot().describe()
     )?;
     if let Some(r) = &scene.reference {
         print_comparison(e, r, out)?;

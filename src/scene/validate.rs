@@ -273,7 +273,8 @@ impl Scene {
         Ok(())
     }
 
-    /// `[diagnostics]`: a gap below half the rod, a positive ray length.
+    /// `[diagnostics]`: a gap below half the rod, a positive ray length, a
+    /// tabled knot, and the paper's clearance where a map is traced.
     fn check_diagnostics(&self) -> Result<(), SceneError> {
         let d = &self.diagnostics;
         positive("diagnostics.self_distance_gap", d.self_distance_gap)?;
@@ -302,6 +303,13 @@ impl Scene {
                 });
             }
             Some(_) => {}
+        }
+        if d.clearance == crate::analysis::class::Clearance::Diameter && self.map.is_some() {
+            return Err(invalid(
+                "diagnostics.clearance",
+                "a map's boundary walk follows the paper's curves (walls, crossings, \
+                 stability), not a self-distance of h: use clearance = \"centreline\" with [map]",
+            ));
         }
         Ok(())
     }
