@@ -361,6 +361,15 @@ fn a_dense_curve_and_degenerate_input_are_handled() {
         knot_type(&lemniscate[..2]),
         Err(KnotError::TooFewPoints(2))
     ));
+    // 2000 random points in a box: hundreds of thousands of crossings, a
+    // clear error rather than gigabytes and hours
+    let tangle: Vec<Vector3<f64>> = (0..2000)
+        .map(|_| Vector3::new(rng.next(), rng.next(), rng.next()))
+        .collect();
+    assert!(matches!(
+        knot_type(&tangle),
+        Err(KnotError::TooManyCrossings(_))
+    ));
     let mut bad = torus(2.0, 3.0, 50);
     bad[7].y = f64::NAN;
     assert!(matches!(knot_type(&bad), Err(KnotError::NotFinite(7))));

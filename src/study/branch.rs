@@ -17,6 +17,9 @@ struct TestValues {
     wall: f64,
     knot: Vec<i64>,
     link: f64,
+    /// The equilibrium they were measured on: states near it are measured
+    /// from it (writhe carried, or jumped across one passage).
+    at: Equilibrium,
 }
 
 impl TestValues {
@@ -25,13 +28,15 @@ impl TestValues {
             wall: eq.wall_distance,
             knot: eq.alexander.clone(),
             link: eq.link,
+            at: eq.clone(),
         }
     }
 }
 
-/// Alexander polynomial (empty: no knot type) and link of a state.
-fn knot_of(state: &RodState, measure: &Measure) -> (Vec<i64>, f64) {
-    let shape = Conformation::of(state, measure);
+/// Alexander polynomial (empty: no knot type) and link of a state near the
+/// measured equilibrium `from`.
+fn knot_of(state: &RodState, measure: &Measure, from: &Equilibrium) -> (Vec<i64>, f64) {
+    let shape = Conformation::continued(state, measure, from);
     let knot = shape.knot.map_or(vec![], |k| k.alexander);
     (knot, state.twist() + shape.writhe)
 }
@@ -355,7 +360,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         let (ka, la) = (wa.knot.clone(), wa.link);
         let p = self
             .locate(a, ds, &mut |_, p| {
-                let (knot, link) = knot_of(&p.state, &measure);
+                let (knot, link) = knot_of(&p.state, &measure, &wa.at);
                 knot == ka && (link - la).abs() < 1.0
             })
             .context("locating a crossing")?;

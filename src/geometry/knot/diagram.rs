@@ -22,7 +22,13 @@ pub(super) enum Degenerate {
     /// Two segments meet in space, near this point: the curve passes through
     /// itself and has no knot type.
     SelfIntersection(Vector3<f64>),
+    /// More crossings than [`MOST_CROSSINGS`] (so many that even listing
+    /// them would take gigabytes).
+    TooMany(usize),
 }
+
+/// Most projection crossings listed (40 MB of them).
+pub(super) const MOST_CROSSINGS: usize = 1_000_000;
 
 fn cross2(a: Vector2<f64>, b: Vector2<f64>) -> f64 {
     a.x * b.y - a.y * b.x
@@ -81,6 +87,9 @@ pub(super) fn crossings(
             }
             if let Some(c) = crossing(&p2, &depth, i, j, scale)? {
                 out.push(c);
+                if out.len() > MOST_CROSSINGS {
+                    return Err(Degenerate::TooMany(out.len()));
+                }
             }
         }
         active.push(j);

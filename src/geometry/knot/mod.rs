@@ -62,10 +62,19 @@ pub enum KnotError {
     /// Every projection direction tried was degenerate.
     #[error("no generic projection among {0} directions")]
     NoGenericProjection(usize),
+    /// The reduced diagram is too large for its determinant (O(n³) per
+    /// prime, n² memory): a curve this tangled is not a rod's knot.
+    #[error(
+        "the curve's diagram keeps {0} crossings after simplification (at most {MAX_CROSSINGS} are resolved): it is too tangled to identify"
+    )]
+    TooManyCrossings(usize),
     /// A coefficient of the Alexander polynomial does not fit in 64 bits.
     #[error("the Alexander polynomial has a coefficient beyond 64 bits")]
     Overflow,
 }
+
+/// Largest reduced diagram whose polynomial is computed (about a second).
+pub const MAX_CROSSINGS: usize = 500;
 
 /// Directions tried before giving up: a polygon in general position has
 /// degenerate projections on a set of measure zero.
@@ -140,10 +149,14 @@ fn along(points: &[Vector3<f64>], dir: &Vector3<f64>) -> Result<KnotType, Option
     let degenerate = |d: Degenerate| match d {
         Degenerate::Projection => None,
         Degenerate::SelfIntersection(at) => Some(KnotError::SelfIntersection(at)),
+        Degenerate::TooMany(n) => Some(KnotError::TooManyCrossings(n)),
     };
     let crossings = diagram::crossings(points, dir).map_err(degenerate)?;
     let mut diagram = Diagram::new(&crossings).map_err(degenerate)?;
     diagram.reduce();
+    if diagram.crossings() > MAX_CROSSINGS {
+        return Err(Some(KnotError::TooManyCrossings(diagram.crossings())));
+    }
     let (a, b, n) = diagram.alexander_matrix();
     // any minor of order n − 1: drop the last row and column
     let m = n.saturating_sub(1);
