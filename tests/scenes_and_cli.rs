@@ -77,6 +77,64 @@ fn bad_scenes_name_the_field() {
             format!("{GOOD}{MAP}trace_from = [0.1, nan]\n"),
             "map.trace_from",
         ),
+        // issue 17's reproductions: extra vector entries, unchecked sweeps,
+        // legs and maps, meaningless settings
+        (
+            format!(
+                "{GOOD}\n[initial]\nshape = \"shooting\"\nn0 = [-24.743, 17.772, 37.145, 999.0]\nm0 = [1.0, 2.0, 3.0]\n"
+            ),
+            "exactly 3 numbers",
+        ),
+        (
+            format!("{GOOD}\n[continuation]\nparameter = \"phi\"\nrange = [0.25, 0.35, 123.0]\n"),
+            "exactly 2 numbers",
+        ),
+        (
+            format!("{GOOD}\n[reference]\nn0 = [1.0, 2.0]\n"),
+            "exactly 3 numbers",
+        ),
+        (
+            format!("{GOOD}\n[reference]\nn0 = [1.0, nan, 2.0]\n"),
+            "reference.n0",
+        ),
+        (
+            format!("{GOOD}\n[reference]\ntwist = inf\n"),
+            "reference.twist",
+        ),
+        (
+            format!("{GOOD}{MAP}\n[sweep]\nparameter = \"delta\"\nvalues = [0.05, -0.5]\n")
+                .replace("[map]\nrange = [0.8, 0.9]\nlines = 2\n", ""),
+            "sweep.values",
+        ),
+        (
+            format!(
+                "{GOOD}\n[continuation]\nparameter = \"phi\"\nrange = [0.2, 0.4]\n[sweep]\nparameter = \"z_star\"\nvalues = [2.0]\n"
+            ),
+            "sweep.values",
+        ),
+        (
+            format!(
+                "{GOOD}\n[[loading]]\nz_star = 0.99\nsteps = 5\n[[loading]]\ndelta = 0.5\nsteps = 5\n"
+            ),
+            "loading.delta",
+        ),
+        (
+            GOOD.replace("z_star = 0.9", "z_star = 0.2")
+                + &MAP.replace("range = [0.8, 0.9]", "range = [0.30, 0.04]"),
+            "map.range",
+        ),
+        (
+            format!("{GOOD}{MAP}grid_columns = 1000000000000\n"),
+            "map.grid_columns",
+        ),
+        (
+            format!("{GOOD}\n[diagnostics]\nray_length = 1e308\n"),
+            "diagnostics.ray_length",
+        ),
+        (
+            format!("{GOOD}\n[initial]\nshape = \"double_ring\"\nsteps = 10000000\n"),
+            "initial.steps",
+        ),
         (
             format!("{GOOD}\n[diagnostics]\nknot = \"12a_1\"\n"),
             "diagnostics.knot",

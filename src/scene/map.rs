@@ -11,6 +11,7 @@ pub struct MapSpec {
     #[serde(default = "default_sweep")]
     pub parameter: Parameter,
     /// Its values, evenly spaced from range[0] to range[1].
+    #[serde(deserialize_with = "crate::scene::exact::array")]
     pub range: [f64; 2],
     /// Number of lines.
     pub lines: usize,
@@ -19,7 +20,7 @@ pub struct MapSpec {
     pub grid_columns: usize,
     /// A known good knot (parameter, φ/2π) the boundary walk starts from,
     /// reached from the scene's start in a straight line (default: the start).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::scene::exact::option")]
     pub trace_from: Option<[f64; 2]>,
     /// Largest step of the boundary walk in the (parameter, φ/2π) plane.
     #[serde(default = "default_trace_step")]
@@ -42,7 +43,7 @@ pub struct SliceSpec {
     #[serde(default)]
     pub start_phi_over_2pi: Option<Vec<f64>>,
     /// Each slice's good knot to start the boundary walk from (`map.trace_from`).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::scene::exact::option_list")]
     pub trace_from: Option<Vec<[f64; 2]>>,
 }
 

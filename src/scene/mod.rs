@@ -159,10 +159,10 @@ pub struct InitialSpec {
     #[serde(default)]
     pub shape: InitialShape,
     /// Shooting data: n(0) in the material frame.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option")]
     pub n0: Option<[f64; 3]>,
     /// Shooting data: m(0) in the material frame.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option")]
     pub m0: Option<[f64; 3]>,
     /// Refine the shooting data by Newton on the s = 1 boundary conditions first.
     #[serde(default)]
@@ -183,7 +183,7 @@ pub struct InitialSpec {
     pub from_recording: Option<PathBuf>,
     /// Straight shape: add a clamped-clamped bump b (1 − cos 2πs)/2 to seed
     /// buckling (b in the lab frame).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option")]
     pub bump: Option<[f64; 3]>,
     /// Trefoil: the integer part of the link (Tw + Wr of the ray closure,
     /// less φ/2π) to give it; default 3, the paper's configuration A.
@@ -236,6 +236,7 @@ pub struct ContinuationSpec {
     /// "phi" (as φ/2π), "z_star" or "delta".
     pub parameter: Parameter,
     /// Stop when the parameter leaves [lo, hi].
+    #[serde(deserialize_with = "exact::array")]
     pub range: [f64; 2],
     /// "up", "down" or "both" from the start.
     #[serde(default)]
@@ -352,6 +353,7 @@ pub struct ContactSpec {
     /// Self-contact (parts at least `diagnostics.self_distance_gap` apart).
     pub self_contact: bool,
     /// Fixed segment obstacles [x0, y0, z0, x1, y1, z1] (radius h/2).
+    #[serde(default, deserialize_with = "exact::list")]
     pub obstacles: Vec<[f64; 6]>,
     /// Pairs closer than h + margin become constraints; no node moves more
     /// than margin/2 per step, so none can pass through another.
@@ -377,10 +379,10 @@ pub struct ReferenceSpec {
     #[serde(default)]
     pub source: Option<String>,
     /// n(0).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option")]
     pub n0: Option<[f64; 3]>,
     /// m(0).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option")]
     pub m0: Option<[f64; 3]>,
     /// Tw.
     #[serde(default)]
@@ -561,5 +563,52 @@ impl SliceSpec {
             }
         }
         s
+    }
+}
+
+/// Arrays of exactly N numbers. TOML's reader fills `[f64; N]` from the
+/// first N entries of a longer list and drops the rest; these read every
+/// entry and refuse a wrong count.
+pub(crate) mod exact {
+    use serde::de::Error;
+    use serde::{Deserialize, Deserializer};
+
+    fn to_array<E: Error, const N: usize>(v: Vec<f64>) -> Result<[f64; N], E> {
+        let n = v.len();
+        v.try_into()
+            .map_err(|_| E::invalid_length(n, &format!("exactly {N} numbers").as_str()))
+    }
+
+    /// `[f64; N]`.
+    pub fn array<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<[f64; N], D::Error> {
+        to_array(Vec::<f64>::deserialize(d)?)
+    }
+
+    /// `Option<[f64; N]>`.
+    pub fn option<'de, D: Deserializer<'de>, const N: usize>(
+        d: D,
+    ) -> Result<Option<[f64; N]>, D::Error> {
+        Option::<Vec<f64>>::deserialize(d)?
+            .map(to_array)
+            .transpose()
+    }
+
+    /// `Vec<[f64; N]>`.
+    pub fn list<'de, D: Deserializer<'de>, const N: usize>(
+        d: D,
+    ) -> Result<Vec<[f64; N]>, D::Error> {
+        Vec::<Vec<f64>>::deserialize(d)?
+            .into_iter()
+            .map(to_array)
+            .collect()
+    }
+
+    /// `Option<Vec<[f64; N]>>`.
+    pub fn option_list<'de, D: Deserializer<'de>, const N: usize>(
+        d: D,
+    ) -> Result<Option<Vec<[f64; N]>>, D::Error> {
+        Option::<Vec<Vec<f64>>>::deserialize(d)?
+            .map(|l| l.into_iter().map(to_array).collect())
+            .transpose()
     }
 }

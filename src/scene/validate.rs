@@ -1,5 +1,6 @@
 //! Scene validation: every value's range checked, the error naming the field.
 
+use crate::model::rod::Parameter;
 use crate::scene::InitialShape;
 use crate::scene::{Scene, SceneError, finite, invalid, positive};
 
@@ -17,6 +18,25 @@ impl Scene {
         self.check_contact()?;
         self.check_diagnostics()?;
         self.check_stability()?;
+        self.check_reference()?;
+        Ok(())
+    }
+
+    /// `[reference]`: finite published values.
+    fn check_reference(&self) -> Result<(), SceneError> {
+        if let Some(r) = &self.reference {
+            for v in r.n0.iter().flatten() {
+                finite("reference.n0", *v)?;
+            }
+            for v in r.m0.iter().flatten() {
+                finite("reference.m0", *v)?;
+            }
+            for (field, v) in [("reference.twist", r.twist), ("reference.link", r.link)] {
+                if let Some(v) = v {
+                    finite(field, v)?;
+                }
+            }
+        }
         Ok(())
     }
 
@@ -42,28 +62,18 @@ impl Scene {
     /// `[clamps]`: finite, δ ≥ 0, the clamps no farther apart than the rod is long.
     fn check_clamps(&self) -> Result<(), SceneError> {
         let c = &self.clamps;
-        finite("clamps.z_star", c.z_star)?;
-        finite("clamps.delta", c.delta)?;
         finite("clamps.phi_over_2pi", c.phi_over_2pi)?;
-        if c.delta < 0.0 {
-            return Err(invalid(
-                "clamps.delta",
-                format!("must be >= 0, got {}", c.delta),
-            ));
+        reachable(["clamps.z_star", "clamps.delta"], c.z_star, c.delta)
+    }
+
+    /// The clamps' (z*, δ) where `parameter` takes the value `v` and the
+    /// other coordinates are the scene's own.
+    fn clamps_at(&self, parameter: Parameter, v: f64) -> (f64, f64) {
+        match parameter {
+            Parameter::ZStar => (v, self.clamps.delta),
+            Parameter::Delta => (self.clamps.z_star, v),
+            Parameter::Phi => (self.clamps.z_star, self.clamps.delta),
         }
-        if c.z_star.abs() > 1.0 {
-            return Err(invalid(
-                "clamps.z_star",
-                format!("|z*| must be <= 1 (the rod has length 1), got {}", c.z_star),
-            ));
-        }
-        if (c.z_star * c.z_star + c.delta * c.delta).sqrt() > 1.0 {
-            return Err(invalid(
-                "clamps.delta",
-                "the clamps are farther apart than the rod's length: sqrt(z*² + δ²) > 1",
-            ));
-        }
-        Ok(())
     }
 
     /// `[initial]`: the data each shape needs.
@@ -82,17 +92,18 @@ impl Scene {
             }
         }
         // RK4 steps of a shooting start, or unfolding steps of the double ring
-        let least = if i.shape == InitialShape::DoubleRing {
-            1
+        // (each unfolding step is a Newton solve: far fewer of them)
+        let (least, most) = if i.shape == InitialShape::DoubleRing {
+            (1, 10_000)
         } else {
-            10
+            (10, 1_000_000)
         };
         if let Some(s) = i.steps
-            && !(least..=10_000_000).contains(&s)
+            && !(least..=most).contains(&s)
         {
             return Err(invalid(
                 "initial.steps",
-                format!("must be in {least}..=10000000, got {s}"),
+                format!("must be in {least}..={most}, got {s}"),
             ));
         }
         if i.shape == InitialShape::File && i.file.is_none() {
@@ -171,12 +182,13 @@ impl Scene {
                     finite(field, v)?;
                 }
             }
-            if l.z_star.is_some_and(|z| z.abs() > 1.0) {
-                return Err(invalid("loading.z_star", "|z*| must be <= 1"));
-            }
-            if l.delta.is_some_and(|d| d < 0.0) {
-                return Err(invalid("loading.delta", "must be >= 0"));
-            }
+        }
+        // each leg ends where the rod can reach
+        let (mut z, mut d) = (self.clamps.z_star, self.clamps.delta);
+        for l in &self.loading {
+            z = l.z_star.unwrap_or(z);
+            d = l.delta.unwrap_or(d);
+            reachable(["loading.z_star", "loading.delta"], z, d)?;
         }
         Ok(())
     }
@@ -192,6 +204,8 @@ impl Scene {
             }
             for v in &sw.values {
                 finite("sweep.values", *v)?;
+                let (z, d) = self.clamps_at(sw.parameter, *v);
+                reachable(["sweep.values", "sweep.values"], z, d)?;
             }
             if Some(sw.parameter) == self.continuation.as_ref().map(|c| c.parameter) {
                 return Err(invalid(
@@ -211,11 +225,18 @@ impl Scene {
             }
             finite("map.range", m.range[0])?;
             finite("map.range", m.range[1])?;
+            if m.range[0] >= m.range[1] {
+                return Err(invalid("map.range", "must be [lo, hi] with lo < hi"));
+            }
+            for v in m.range {
+                let (z, d) = self.clamps_at(m.parameter, v);
+                reachable(["map.range", "map.range"], z, d)?;
+            }
             if m.lines == 0 || m.lines > 100_000 {
                 return Err(invalid("map.lines", "must be in 1..=100000"));
             }
-            if m.grid_columns < 2 {
-                return Err(invalid("map.grid_columns", "must be >= 2"));
+            if m.grid_columns < 2 || m.grid_columns > 100_000 {
+                return Err(invalid("map.grid_columns", "must be in 2..=100000"));
             }
             positive("map.trace_step", m.trace_step)?;
             for v in m.trace_from.iter().flatten() {
@@ -227,6 +248,10 @@ impl Scene {
                 }
                 if sl.values.windows(2).any(|w| w[1] <= w[0]) {
                     return Err(invalid("map.slices.values", "must be increasing"));
+                }
+                for v in &sl.values {
+                    let (z, d) = self.clamps_at(sl.parameter, *v);
+                    reachable(["map.slices.values", "map.slices.values"], z, d)?;
                 }
                 if sl.parameter == m.parameter
                     || Some(sl.parameter) == self.continuation.as_ref().map(|c| c.parameter)
@@ -285,6 +310,13 @@ impl Scene {
             ));
         }
         positive("diagnostics.ray_length", d.ray_length)?;
+        if d.ray_length > 1e12 {
+            // the writhe's far-loop terms lose every digit past this
+            return Err(invalid(
+                "diagnostics.ray_length",
+                format!("must be <= 1e12, got {}", d.ray_length),
+            ));
+        }
         match crate::geometry::knot::alexander_of(&d.knot) {
             None => {
                 return Err(SceneError::Invalid {
@@ -324,4 +356,30 @@ impl Scene {
         }
         Ok(())
     }
+}
+
+/// Clamps at (z*, δ) that a rod of length 1 can reach: finite, δ ≥ 0,
+/// |z*| ≤ 1 and sqrt(z*² + δ²) ≤ 1; `fields` name z* and δ.
+fn reachable(fields: [&'static str; 2], z_star: f64, delta: f64) -> Result<(), SceneError> {
+    finite(fields[0], z_star)?;
+    finite(fields[1], delta)?;
+    if delta < 0.0 {
+        return Err(invalid(fields[1], format!("δ must be >= 0, got {delta}")));
+    }
+    if z_star.abs() > 1.0 {
+        return Err(invalid(
+            fields[0],
+            format!("|z*| must be <= 1 (the rod has length 1), got {z_star}"),
+        ));
+    }
+    if (z_star * z_star + delta * delta).sqrt() > 1.0 {
+        return Err(invalid(
+            fields[1],
+            format!(
+                "the clamps are farther apart than the rod's length: sqrt(z*² + δ²) = {} > 1 (z* = {z_star}, δ = {delta})",
+                (z_star * z_star + delta * delta).sqrt()
+            ),
+        ));
+    }
+    Ok(())
 }
