@@ -135,6 +135,19 @@ fn bad_scenes_name_the_field() {
             format!("{GOOD}\n[initial]\nshape = \"double_ring\"\nsteps = 10000000\n"),
             "initial.steps",
         ),
+        (GOOD.replace("K2 = 3.0", "K2 = 1e308"), "model.K2"),
+        (
+            GOOD.replace("K2 = 3.0", "K2 = 3.0\nstretching_stiffness = 1e308"),
+            "model.stretching_stiffness",
+        ),
+        (
+            GOOD.replace("K2 = 3.0", "K2 = 3.0\nrod_diameter = 1e-200"),
+            "model.rod_diameter",
+        ),
+        (
+            format!("{GOOD}\n[initial]\nbump = [0.0, nan, 0.0]\n"),
+            "initial.bump",
+        ),
         (
             format!("{GOOD}\n[diagnostics]\nknot = \"12a_1\"\n"),
             "diagnostics.knot",
@@ -152,6 +165,14 @@ fn bad_scenes_name_the_field() {
             "diagnostics.clearance",
         ),
     ];
+    // a 200 KB line is not echoed whole
+    let long = format!("{GOOD}\nname = \"{}\n", "x".repeat(200_000));
+    let msg = error_of(&long);
+    assert!(
+        msg.len() < 1000 && msg.contains("line"),
+        "{} bytes",
+        msg.len()
+    );
     // a tabled knot or a sum of them is accepted
     let sum = Scene::parse(&format!("{GOOD}\n[diagnostics]\nknot = \"3_1#4_1\"\n")).unwrap();
     assert_eq!(sum.good_knot().alexander, vec![-1, 4, -5, 4, -1]);

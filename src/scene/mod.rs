@@ -463,12 +463,44 @@ pub(crate) fn positive(field: &'static str, v: f64) -> Result<f64, SceneError> {
     }
 }
 
+/// The parser's message with its line and column and at most 120
+/// characters of the line around the column (a long line is not echoed).
+fn parse_message(text: &str, e: &toml::de::Error) -> String {
+    let Some(span) = e.span() else {
+        return e.message().to_string();
+    };
+    let start = span.start.min(text.len());
+    let before = text.get(..start).unwrap_or("");
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let column = before[line_start..].chars().count() + 1;
+    let whole: Vec<char> = text[line_start..]
+        .lines()
+        .next()
+        .unwrap_or("")
+        .chars()
+        .collect();
+    let (from, to) = if whole.len() <= 120 {
+        (0, whole.len())
+    } else {
+        let from = column.saturating_sub(40).min(whole.len());
+        (from, (from + 120).min(whole.len()))
+    };
+    let snippet: String = whole[from..to].iter().collect();
+    format!(
+        "line {line}, column {column}: {}\n  {}{snippet}{}",
+        e.message().trim_end(),
+        if from > 0 { "…" } else { "" },
+        if to < whole.len() { "…" } else { "" }
+    )
+}
+
 impl Scene {
     /// Parse and validate scene text.
     pub fn parse(text: &str) -> Result<Scene, SceneError> {
         let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
             path: PathBuf::from("<text>"),
-            message: e.to_string(),
+            message: parse_message(text, &e),
         })?;
         scene.validate()?;
         Ok(scene)

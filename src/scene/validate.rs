@@ -46,6 +46,13 @@ impl Scene {
         positive("model.strip_regularisation", m.strip_regularisation)?;
         positive("model.K2", m.k2)?;
         positive("model.K3", m.k3)?;
+        // ratios of bending and twisting stiffnesses: past these the
+        // Hessian's condition number exceeds what f64 resolves
+        for (field, k) in [("model.K2", m.k2), ("model.K3", m.k3)] {
+            if !(1e-6..=1e6).contains(&k) {
+                return Err(invalid(field, format!("must be in [1e-6, 1e6], got {k}")));
+            }
+        }
         if m.segments < 4 || m.segments > 1_000_000 {
             return Err(invalid(
                 "model.segments",
@@ -53,8 +60,25 @@ impl Scene {
             ));
         }
         positive("model.rod_diameter", m.rod_diameter)?;
+        if !(1e-5..=0.5).contains(&m.rod_diameter) {
+            // the stretching stiffness 16/h² follows it; past 1e-5 it
+            // swamps bending by more than f64 resolves
+            return Err(invalid(
+                "model.rod_diameter",
+                format!(
+                    "must be in [1e-5, 0.5] (rod lengths), got {}",
+                    m.rod_diameter
+                ),
+            ));
+        }
         if let Some(s) = m.stretching_stiffness {
             positive("model.stretching_stiffness", s)?;
+            if s > 1e12 {
+                return Err(invalid(
+                    "model.stretching_stiffness",
+                    format!("must be <= 1e12 (EA L²/EI), got {s}"),
+                ));
+            }
         }
         Ok(())
     }
@@ -105,6 +129,9 @@ impl Scene {
                 "initial.steps",
                 format!("must be in {least}..={most}, got {s}"),
             ));
+        }
+        for v in i.bump.iter().flatten() {
+            finite("initial.bump", *v)?;
         }
         if i.shape == InitialShape::File && i.file.is_none() {
             return Err(invalid("initial.file", "required for shape = \"file\""));
