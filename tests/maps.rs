@@ -92,6 +92,28 @@ fn shards_merge_to_the_single_run_bit_for_bit_and_maps_resume() {
         assert_eq!(stamp(k), before[k], "line {k} was recomputed");
     }
     assert!(std::fs::read(&whole).unwrap() == a);
+    // the kept lines belong to their scene and N: a run at another N does
+    // not reuse them, and the scene's own N afterwards gets its own back
+    let w = whole.to_str().unwrap();
+    let fresh = dir.join("fresh").join("n20.json");
+    knotrod_ok(&[
+        "map",
+        s,
+        "--segments",
+        "20",
+        "--json",
+        fresh.to_str().unwrap(),
+    ]);
+    knotrod_ok(&["map", s, "--segments", "20", "--json", w]);
+    assert!(
+        std::fs::read(&whole).unwrap() == std::fs::read(&fresh).unwrap(),
+        "N = 20 reused the N = 40 lines"
+    );
+    knotrod_ok(&["map", s, "--json", w]);
+    assert!(
+        std::fs::read(&whole).unwrap() == a,
+        "N = 40 reused the N = 20 lines"
+    );
 }
 
 /// The island's boundary traced by two-parameter continuation (the walk

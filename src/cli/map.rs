@@ -174,7 +174,7 @@ fn compute_lines(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} lines, ETA {eta} — {msg}")
             .unwrap(),
     );
-    let store = LineFolder::create(cache)?;
+    let store = LineFolder::create(cache, scene, spec, segments)?;
     let lines = crate::study::map::compute_lines(scene, spec, indices, segments, &store, &|l| {
         progress.inc(1);
         progress.set_message(format!(

@@ -58,17 +58,50 @@ fn write_atomically(file: &Path, bytes: &[u8]) -> Result<(), MapFileError> {
     std::fs::rename(&tmp, file).map_err(file_error("writing", file))
 }
 
-/// The lines of a map kept as `line_KKKKK.json` in a folder.
+/// The lines of a map kept as `line_KKKKK.json` in a folder, each with the
+/// key of what made it.
 pub struct LineFolder {
     folder: PathBuf,
+    key: String,
+}
+
+/// A kept line and what it was computed from.
+#[derive(Serialize, Deserialize)]
+struct KeptLine {
+    key: String,
+    line: Line,
+}
+
+/// What determines a map's lines and walk: the whole scene after defaults
+/// (model, start, solver, continuation, map), the map settings, N and the
+/// program's version.
+fn cache_key(
+    scene: &Scene,
+    spec: &MapSpec,
+    segments: Option<usize>,
+) -> Result<String, MapFileError> {
+    Ok(serde_json::to_string(&(
+        scene,
+        spec,
+        segments.unwrap_or(scene.model.segments as usize),
+        env!("CARGO_PKG_VERSION"),
+    ))?)
 }
 
 impl LineFolder {
-    /// The folder (created if need be).
-    pub fn create(folder: &Path) -> Result<Self, MapFileError> {
+    /// The folder (created if need be) for the lines of `spec` over `scene`
+    /// at N = `segments` (the scene's own if None): lines kept there for
+    /// anything else are recomputed.
+    pub fn create(
+        folder: &Path,
+        scene: &Scene,
+        spec: &MapSpec,
+        segments: Option<usize>,
+    ) -> Result<Self, MapFileError> {
         std::fs::create_dir_all(folder).map_err(file_error("creating", folder))?;
         Ok(LineFolder {
             folder: folder.to_path_buf(),
+            key: cache_key(scene, spec, segments)?,
         })
     }
 
@@ -81,12 +114,17 @@ impl LineStore for LineFolder {
     fn get(&self, index: usize, value: f64) -> Option<Line> {
         std::fs::read_to_string(self.file(index))
             .ok()
-            .and_then(|t| serde_json::from_str::<Line>(&t).ok())
+            .and_then(|t| serde_json::from_str::<KeptLine>(&t).ok())
+            .filter(|k| k.key == self.key)
+            .map(|k| k.line)
             .filter(|l| l.index == index && l.value == value)
     }
 
     fn put(&self, line: &Line) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-        let bytes = serde_json::to_vec(line)?;
+        let bytes = serde_json::to_vec(&KeptLine {
+            key: self.key.clone(),
+            line: line.clone(),
+        })?;
         write_atomically(&self.file(line.index), &bytes)?;
         Ok(())
     }
@@ -109,8 +147,7 @@ pub fn trace_cached(
     }
     std::fs::create_dir_all(cache).map_err(file_error("creating", cache))?;
     let file = cache.join("trace.json");
-    // a walk depends on the whole scene (model, start, map settings) and N
-    let key = serde_json::to_string(&(scene, spec, segments))?;
+    let key = cache_key(scene, spec, segments)?;
     if let Some(c) = std::fs::read_to_string(&file)
         .ok()
         .and_then(|t| serde_json::from_str::<Cached>(&t).ok())

@@ -174,7 +174,7 @@ fn island_workloads(fig7: &Scene) -> Result<Vec<Workload>> {
             &spec,
             &idx,
             Some(60),
-            &crate::io::map_files::LineFolder::create(&cache)?,
+            &crate::io::map_files::LineFolder::create(&cache, &island, &spec, Some(60))?,
             &|_| {},
         )?;
         let _ = std::fs::remove_dir_all(&cache);
@@ -193,7 +193,7 @@ fn island_workloads(fig7: &Scene) -> Result<Vec<Workload>> {
             &spec,
             &idx,
             None,
-            &crate::io::map_files::LineFolder::create(&cache)?,
+            &crate::io::map_files::LineFolder::create(&cache, fig7, &spec, None)?,
             &|_| {},
         )?;
         let _ = std::fs::remove_dir_all(&cache);

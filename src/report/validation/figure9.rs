@@ -65,7 +65,7 @@ fn slice_maps(scene: &Scene, slices: &SliceSpec, phi_range: [f64; 2]) -> Result<
             &sspec,
             &idx,
             None,
-            &crate::io::map_files::LineFolder::create(&cache)?,
+            &crate::io::map_files::LineFolder::create(&cache, &slice, &sspec, None)?,
             &|_| {},
         )?;
         let traced = crate::io::map_files::trace_cached(&slice, &sspec, None, &cache, &|_, _| {})?;

@@ -67,7 +67,7 @@ fn island_map(scene: &Scene, spec: &MapSpec, name: &str, phi_range: [f64; 2]) ->
         spec,
         &indices,
         None,
-        &crate::io::map_files::LineFolder::create(&cache)?,
+        &crate::io::map_files::LineFolder::create(&cache, scene, spec, None)?,
         &|_| {},
     )?;
     let traced = crate::io::map_files::trace_cached(scene, spec, None, &cache, &|_, _| {})?;
