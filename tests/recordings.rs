@@ -292,6 +292,43 @@ fn damaged_recordings_give_clear_errors() {
     let e = read_state(&rec, 10_000).err().unwrap();
     assert!(matches!(e, knotrod::io::IoError::Recording { .. }), "{e}");
     assert!(e.to_string().contains("no state with index 10000"), "{e}");
+    // corruption inside a chunk is detected (its CRC), never read as data or
+    // turned into an allocation of a corrupted length
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let mut damaged = Vec::new();
+    for (k, chunk) in summary.chunk_indexes.iter().take(4).enumerate() {
+        let (start, len) = (
+            chunk.chunk_start_offset as usize,
+            chunk.chunk_length as usize,
+        );
+        let mut flipped = bytes.clone();
+        flipped[start + len / 2 + k] ^= 1 << (k % 8);
+        damaged.push(("one bit", flipped));
+        let mut zeroed = bytes.clone();
+        let from = start + len / 3;
+        let to = (from + 1700).min(start + len);
+        zeroed[from..to].fill(0);
+        damaged.push(("1.7 KB zeroed", zeroed));
+    }
+    assert!(damaged.len() >= 2);
+    for (i, (what, b)) in damaged.iter().enumerate() {
+        let path = dir.join(format!("damaged_{i}.mcap"));
+        std::fs::write(&path, b).unwrap();
+        assert!(
+            read_recording(&path).is_err(),
+            "{what} in a chunk read as data"
+        );
+        for cmd in ["info", "export"] {
+            let out = knotrod(&[cmd, path.to_str().unwrap()]);
+            let err = String::from_utf8_lossy(&out.stderr);
+            // an exit code, not a signal (an abort has none)
+            assert!(
+                out.status.code().is_some_and(|c| c != 0) && !err.contains("panicked"),
+                "{cmd} on {what}: {:?} {err}",
+                out.status
+            );
+        }
+    }
 }
 
 #[test]

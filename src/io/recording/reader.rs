@@ -31,53 +31,115 @@ fn unreadable(path: &Path) -> impl Fn(mcap::McapError) -> IoError + Copy + use<'
     }
 }
 
+/// One record of a recording, as the validated pass hands it on.
+enum Item<'a> {
+    /// A message on a topic.
+    Message { topic: &'a str, data: &'a [u8] },
+    /// A metadata record.
+    Metadata(mcap::records::Metadata),
+}
+
+/// Every message and metadata record of an MCAP file, in file order, with
+/// its chunks' CRCs checked before any of their records is used, the data
+/// section's CRC checked, and no record longer than the file allowed (so a
+/// corrupted length is an error, not an allocation of that size).
+fn each_record(path: &Path, bytes: &[u8], mut on: impl FnMut(Item) -> Result<()>) -> Result<()> {
+    use mcap::records::Record;
+    use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+    let bad = unreadable(path);
+    let options = LinearReaderOptions::default()
+        .with_prevalidate_chunk_crcs(true)
+        .with_validate_data_section_crc(true)
+        .with_validate_summary_section_crc(true)
+        // no record (or decompressed chunk) is longer than 64 times the file
+        .with_record_length_limit(bytes.len().saturating_mul(64).max(1 << 16));
+    let mut reader = LinearReader::new_with_options(options);
+    let mut rest = bytes;
+    let mut topics: BTreeMap<u16, String> = BTreeMap::new();
+    while let Some(event) = reader.next_event() {
+        match event.map_err(bad)? {
+            LinearReadEvent::ReadRequest(need) => {
+                let len = need.min(rest.len());
+                reader.insert(len).copy_from_slice(&rest[..len]);
+                reader.notify_read(len);
+                rest = &rest[len..];
+            }
+            LinearReadEvent::Record { data, opcode } => {
+                match mcap::parse_record(opcode, data).map_err(bad)? {
+                    Record::Channel(c) => {
+                        topics.insert(c.id, c.topic);
+                    }
+                    Record::Message { header, data } => {
+                        let topic =
+                            topics
+                                .get(&header.channel_id)
+                                .ok_or_else(|| IoError::Recording {
+                                    path: path.into(),
+                                    reason: format!(
+                                        "a message on channel {} that was never declared",
+                                        header.channel_id
+                                    ),
+                                })?;
+                        on(Item::Message { topic, data: &data })?;
+                    }
+                    Record::Metadata(m) => on(Item::Metadata(m))?,
+                    _ => {}
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Read scalars, events, metadata and channel counts of a recording.
 pub fn read_recording(path: &Path) -> Result<Recording> {
     let bytes = read_bytes(path)?;
-    let bad = unreadable(path);
     let mut rec = Recording::default();
-    for m in mcap::MessageStream::new(&bytes).map_err(bad)? {
-        let m = m.map_err(bad)?;
-        *rec.channels.entry(m.channel.topic.clone()).or_insert(0) += 1;
-        match m.channel.topic.as_str() {
-            SCALARS_TOPIC => rec.scalars.push(
-                serde_json::from_slice(&m.data)
-                    .map_err(IoError::json("malformed scalars message", path))?,
-            ),
-            EVENTS_TOPIC => rec.events.push(
-                serde_json::from_slice(&m.data)
-                    .map_err(IoError::json("malformed event message", path))?,
-            ),
-            _ => {}
+    each_record(path, &bytes, |item| {
+        match item {
+            Item::Message { topic, data } => {
+                *rec.channels.entry(topic.to_string()).or_insert(0) += 1;
+                match topic {
+                    SCALARS_TOPIC => rec.scalars.push(
+                        serde_json::from_slice(data)
+                            .map_err(IoError::json("malformed scalars message", path))?,
+                    ),
+                    EVENTS_TOPIC => rec.events.push(
+                        serde_json::from_slice(data)
+                            .map_err(IoError::json("malformed event message", path))?,
+                    ),
+                    _ => {}
+                }
+            }
+            Item::Metadata(md) if md.name == "knotrod" => rec.metadata = md.metadata,
+            Item::Metadata(_) => {}
         }
-    }
-    for r in mcap::read::LinearReader::new(&bytes).map_err(bad)? {
-        if let mcap::records::Record::Metadata(md) = r.map_err(bad)?
-            && md.name == "knotrod"
-        {
-            rec.metadata = md.metadata;
-        }
-    }
+        Ok(())
+    })?;
     Ok(rec)
 }
 
 /// The state with index `index` of a recording, with its model.
 pub fn read_state(path: &Path, index: u64) -> Result<StateMessage> {
     let bytes = read_bytes(path)?;
-    let bad = unreadable(path);
-    let mut count = 0;
-    for m in mcap::MessageStream::new(&bytes).map_err(bad)? {
-        let m = m.map_err(bad)?;
-        if m.channel.topic == STATE_TOPIC {
+    let (mut count, mut found) = (0, None);
+    each_record(path, &bytes, |item| {
+        if let Item::Message {
+            topic: STATE_TOPIC,
+            data,
+        } = item
+            && found.is_none()
+        {
             count += 1;
-            let s: StateMessage = serde_json::from_slice(&m.data)
+            let s: StateMessage = serde_json::from_slice(data)
                 .map_err(IoError::json("malformed state message", path))?;
             if s.index == index {
-                return Ok(s);
+                found = Some(s);
             }
         }
-    }
-    Err(IoError::Recording {
+        Ok(())
+    })?;
+    found.ok_or_else(|| IoError::Recording {
         path: path.into(),
         reason: format!("no state with index {index} ({count} states recorded)"),
     })
