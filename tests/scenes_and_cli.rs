@@ -190,6 +190,41 @@ fn bad_scenes_name_the_field() {
 }
 
 #[test]
+fn outputs_stay_where_they_belong() {
+    // a scene's name cannot lead its files out of recordings/
+    for (name, stem) in [
+        ("../x", "_x"),
+        ("/tmp/evil", "_tmp_evil"),
+        ("fig 3", "fig_3"),
+        ("..", "run"),
+    ] {
+        let s = Scene::parse(&format!("name = \"{name}\"\n{GOOD}")).unwrap();
+        assert_eq!(s.file_stem("run"), stem, "{name}");
+    }
+    // the summary never overwrites its own stream, nor is it a folder: both
+    // refused before any work
+    let dir = temp_dir("outputs");
+    for json in [dir.join("run.jsonl"), dir.clone()] {
+        let out = knotrod(&[
+            "run",
+            "scenes/appendix_d.toml",
+            "--json",
+            json.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains("--json"), "{err}");
+        assert!(
+            !String::from_utf8_lossy(&out.stdout).contains("equilibria"),
+            "the work ran"
+        );
+    }
+    assert!(
+        std::fs::read_dir(&dir).unwrap().next().is_none(),
+        "stray files left"
+    );
+}
+
+#[test]
 fn run_writes_summary_and_restarts_from_it() {
     let dir = temp_dir("cli");
     let first = dir.join("first.json");

@@ -22,7 +22,7 @@ pub fn map(
         .map
         .clone()
         .context("the scene has no [map] section")?;
-    let name = scene.name.clone().unwrap_or_else(|| "map".into());
+    let name = scene.file_stem("map");
     let json = json.unwrap_or_else(|| PathBuf::from("recordings").join(format!("{name}.map.json")));
     let shard = match shard {
         Some(s) => Some(parse_shard(s)?),

@@ -107,8 +107,21 @@ impl Outputs {
     ) -> Result<Self> {
         let stream = match json {
             Some(p) => {
-                create_parent(p)?;
+                // checked before the work, not after it
+                anyhow::ensure!(
+                    !p.is_dir(),
+                    "--json {}: is a folder; name the summary's file",
+                    p.display()
+                );
                 let lines = p.with_extension("jsonl");
+                anyhow::ensure!(
+                    lines != p,
+                    "--json {}: the summary would overwrite its own stream of \
+                     equilibria ({}); name it with .json",
+                    p.display(),
+                    lines.display()
+                );
+                create_parent(p)?;
                 let file = File::create(&lines)
                     .with_context(|| format!("creating {}", lines.display()))?;
                 Some((BufWriter::new(file), lines))
@@ -118,9 +131,18 @@ impl Outputs {
         let recorder = match record {
             Some(file) => {
                 let file = file.unwrap_or_else(|| {
-                    PathBuf::from("recordings")
-                        .join(format!("{}.mcap", scene.name.as_deref().unwrap_or("run")))
+                    PathBuf::from("recordings").join(format!("{}.mcap", scene.file_stem("run")))
                 });
+                anyhow::ensure!(
+                    !file.is_dir(),
+                    "--record {}: is a folder; name the recording's file",
+                    file.display()
+                );
+                anyhow::ensure!(
+                    json.is_none_or(|j| j != file && j.with_extension("jsonl") != file),
+                    "--record {}: the same file as the JSON summary or its stream",
+                    file.display()
+                );
                 let text = std::fs::read_to_string(scene_path).unwrap_or_default();
                 Some(Recorder::create(
                     &file,
@@ -214,7 +236,7 @@ fn report(
     print_events(&summary.events, out)?;
     let stem = json
         .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("recordings").join(&summary.scene));
+        .unwrap_or_else(|| PathBuf::from("recordings").join(scene.file_stem("run")));
     create_parent(&stem)?;
     let title = format!("{} (N = {})", summary.scene, summary.segments);
     let points: Vec<PlotPoint> = summary.equilibria.iter().map(PlotPoint::from).collect();

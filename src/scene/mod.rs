@@ -556,6 +556,29 @@ impl Scene {
             .unwrap_or_else(|| GoodKnot::paper(self.model.rod_diameter))
     }
 
+    /// Its name as a file name under `recordings/`: letters, digits, `-`,
+    /// `_` and inner dots kept, anything else (a `/`, `..`) made `_`, so a
+    /// name cannot point outside the folder; `default` if it has none.
+    pub fn file_stem(&self, default: &str) -> String {
+        let name = self.name.as_deref().unwrap_or(default);
+        let safe: String = name
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        let safe = safe.trim_start_matches('.').to_string();
+        if safe.is_empty() {
+            default.to_string()
+        } else {
+            safe
+        }
+    }
+
     /// The measurement settings of its equilibria.
     pub fn measure(&self) -> Measure {
         Measure {
