@@ -416,3 +416,16 @@ fn knot_command_names_small_knots() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("line 2") && !err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn every_shipped_scene_passes_validation() {
+    let mut count = 0;
+    for entry in std::fs::read_dir("scenes").unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            Scene::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            count += 1;
+        }
+    }
+    assert!(count >= 13, "{count} scenes");
+}
