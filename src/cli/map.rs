@@ -1,9 +1,10 @@
 //! `knotrod map` and `knotrod merge`: the good-knot region of a scene.
 
+use super::progress::Progress;
 use crate::io::json::write_pretty;
 use crate::io::map_files::{LineFolder, Partial, merge as merge_parts, trace_cached};
 use crate::scene::MapSpec;
-use crate::scene::Scene;
+use crate::scene::{Job, Scene};
 use crate::study::boundary::Traced;
 use crate::study::map::{Line, Map, Map3};
 use anyhow::{Context, Result};
@@ -16,8 +17,16 @@ pub fn map(
     json: Option<PathBuf>,
     shard: Option<&str>,
     segments: Option<usize>,
+    allow_large: bool,
 ) -> Result<()> {
     let scene = Scene::load(path)?;
+    if let Some(n) = segments {
+        anyhow::ensure!(
+            (4..=1_000_000).contains(&n),
+            "--segments must be in 4..=1000000, got {n}"
+        );
+    }
+    scene.check_budget(Job::Map, segments, allow_large)?;
     let spec = scene
         .map
         .clone()
@@ -152,12 +161,11 @@ fn map_plane(
 /// The boundary walk of a plane, with a spinner (one sequential computation:
 /// shard 0 carries it).
 fn trace(scene: &Scene, spec: &MapSpec, segments: Option<usize>, cache: &Path) -> Result<Traced> {
-    let spinner = indicatif::ProgressBar::new_spinner();
+    let spinner = Progress::spinner("boundary points");
     let t = trace_cached(scene, spec, segments, cache, &|k, on| {
-        spinner.set_message(format!("tracing the boundary: point {k}, on {on}"));
-        spinner.tick();
+        spinner.item(format!("tracing the boundary: point {k}, on {on}"));
     })?;
-    spinner.finish_and_clear();
+    spinner.finish();
     Ok(t)
 }
 
@@ -169,22 +177,17 @@ fn compute_lines(
     segments: Option<usize>,
     cache: &Path,
 ) -> Result<Vec<Line>> {
-    let progress = indicatif::ProgressBar::new(indices.len() as u64);
-    progress.set_style(
-        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} lines, ETA {eta} — {msg}")
-            .unwrap(),
-    );
+    let progress = Progress::bar(indices.len() as u64, "lines");
     let store = LineFolder::create(cache, scene, spec, segments)?;
     let lines = crate::study::map::compute_lines(scene, spec, indices, segments, &store, &|l| {
-        progress.inc(1);
-        progress.set_message(format!(
+        progress.item(format!(
             "{} = {:.4}: {} good intervals",
             spec.parameter.name(),
             l.value,
             l.intervals.len()
         ));
     })?;
-    progress.finish_and_clear();
+    progress.finish();
     Ok(lines)
 }
 

@@ -4,6 +4,7 @@
 mod knot;
 mod map;
 mod plot;
+mod progress;
 mod reports;
 mod run;
 
@@ -41,6 +42,9 @@ pub enum Command {
         /// Do not record.
         #[arg(long, conflicts_with = "record")]
         no_record: bool,
+        /// Run even when the predicted memory or CPU time exceeds `[budget]`.
+        #[arg(long)]
+        allow_large: bool,
     },
     /// Channels, states, parameter range and events of a recording.
     Info {
@@ -97,6 +101,9 @@ pub enum Command {
         /// Override the scene's number of segments.
         #[arg(long)]
         segments: Option<usize>,
+        /// Map even when the predicted memory or CPU time exceeds `[budget]`.
+        #[arg(long)]
+        allow_large: bool,
     },
     /// Join partial maps (from `map --shard`) into one map.
     Merge {
@@ -128,6 +135,9 @@ pub enum Command {
         /// Segment counts, comma separated.
         #[arg(long, value_delimiter = ',', default_value = "50,100,200,400,800")]
         segments: Vec<usize>,
+        /// Run even when the predicted memory or CPU time exceeds `[budget]`.
+        #[arg(long)]
+        allow_large: bool,
     },
 }
 
@@ -140,11 +150,13 @@ pub fn main_with(cli: Cli) -> Result<()> {
             segments,
             record,
             no_record,
+            allow_large,
         } => run::run(
             &scene,
             json,
             segments,
             if no_record { None } else { Some(record) },
+            allow_large,
         ),
         Command::Info { recording } => Ok(crate::io::export::info(
             &recording,
@@ -161,7 +173,11 @@ pub fn main_with(cli: Cli) -> Result<()> {
             format,
             out.as_deref(),
         )?),
-        Command::Convergence { scene, segments } => reports::convergence(&scene, &segments),
+        Command::Convergence {
+            scene,
+            segments,
+            allow_large,
+        } => reports::convergence(&scene, &segments, allow_large),
         Command::Knot {
             curve,
             closed,
@@ -174,7 +190,8 @@ pub fn main_with(cli: Cli) -> Result<()> {
             json,
             shard,
             segments,
-        } => map::map(&scene, json, shard.as_deref(), segments),
+            allow_large,
+        } => map::map(&scene, json, shard.as_deref(), segments, allow_large),
         Command::Merge { parts, json } => map::merge(&parts, &json),
         Command::Bench { scenes, json } => reports::bench(&scenes, json),
         Command::Validate { scenes } => reports::validate(&scenes),

@@ -36,8 +36,8 @@ fn from_recording(path: &Path) -> Result<(String, Vec<PlotPoint>, Vec<Event>)> {
 
 /// Title, points and events of a JSON summary.
 fn from_summary(path: &Path) -> Result<(String, Vec<PlotPoint>, Vec<Event>)> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::io::read_text(path, crate::io::DATA_FILE_LIMIT)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let s: Summary = serde_json::from_str(&text)
         .with_context(|| format!("{} is not a knotrod summary", path.display()))?;
     let points = s.equilibria.iter().map(PlotPoint::from).collect();

@@ -2,7 +2,7 @@
 
 use crate::io::json::write_pretty;
 use crate::report::validation;
-use crate::scene::Scene;
+use crate::scene::{Job, Scene};
 use anyhow::Result;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -24,8 +24,15 @@ pub fn validate(scenes: &Path) -> Result<()> {
 }
 
 /// Print the convergence table in N of a scene's equilibrium.
-pub fn convergence(path: &Path, segments: &[usize]) -> Result<()> {
+pub fn convergence(path: &Path, segments: &[usize], allow_large: bool) -> Result<()> {
     let scene = Scene::load(path)?;
+    for &n in segments {
+        anyhow::ensure!(
+            (4..=1_000_000).contains(&n),
+            "--segments must be in 4..=1000000, got {n}"
+        );
+        scene.check_budget(Job::Run, Some(n), allow_large)?;
+    }
     write!(
         std::io::stdout().lock(),
         "{}",

@@ -2,6 +2,7 @@
 //! and the MCAP recording as it is computed, then print and plot the result
 //! and write the summary.
 
+use super::progress::Progress;
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
 use crate::io::json::create_parent;
@@ -9,7 +10,7 @@ use crate::io::plot::{PlotPoint, bifurcation_diagram};
 use crate::io::recording::Recorder;
 use crate::io::summary::{Summary, print_equilibrium, print_events};
 use crate::model::rod::RodModel;
-use crate::scene::Scene;
+use crate::scene::{Job, Scene};
 use crate::study::error::StudyError;
 use crate::study::run::run_scene;
 use anyhow::{Context, Result};
@@ -29,6 +30,7 @@ pub fn run(
     json: Option<PathBuf>,
     segments: Option<usize>,
     record: Option<Option<PathBuf>>,
+    allow_large: bool,
 ) -> Result<()> {
     let scene = Scene::load(path)?;
     let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
@@ -38,17 +40,18 @@ pub fn run(
             "--segments must be in 4..=1000000, got {n}"
         );
     }
+    scene.check_budget(Job::Run, segments, allow_large)?;
     let model = scene.rod_model(segments);
     let start = std::time::Instant::now();
     let json = json.or(scene.output.json.clone());
     let mut summary = Summary::new(&scene, &model);
     let mut outputs = Outputs::open(path, &scene, &model, json.as_deref(), record)?;
-    let progress = Progress::new();
+    let progress = Progress::spinner("equilibria");
     let result = run_scene(&scene, segments, &mut |eq: Equilibrium| {
         outputs
             .equilibrium(&eq)
             .map_err(|e| StudyError::Observer(e.into()))?;
-        progress.equilibrium(&eq);
+        progress.item(describe(&eq));
         summary.equilibria.push(eq);
         if INTERRUPTED.load(Ordering::SeqCst) {
             return Err(StudyError::Observer(
@@ -188,35 +191,17 @@ impl Outputs {
     }
 }
 
-/// The spinner showing the last equilibrium computed.
-struct Progress(indicatif::ProgressBar);
-
-impl Progress {
-    fn new() -> Self {
-        let bar = indicatif::ProgressBar::new_spinner();
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} {elapsed} {pos} equilibria — {msg}")
-                .unwrap(),
-        );
-        Progress(bar)
-    }
-
-    fn equilibrium(&self, eq: &Equilibrium) {
-        self.0.inc(1);
-        self.0.set_message(format!(
-            "branch {}: z* = {:.4}, δ = {:.4}, φ/2π = {:.4}, Tw = {:.4}{}",
-            eq.branch,
-            eq.z_star,
-            eq.delta,
-            eq.phi_over_2pi,
-            eq.twist,
-            if eq.stable { "" } else { " (unstable)" }
-        ));
-    }
-
-    fn finish(self) {
-        self.0.finish_and_clear();
-    }
+/// One line for the progress display.
+fn describe(eq: &Equilibrium) -> String {
+    format!(
+        "branch {}: z* = {:.4}, δ = {:.4}, φ/2π = {:.4}, Tw = {:.4}{}",
+        eq.branch,
+        eq.z_star,
+        eq.delta,
+        eq.phi_over_2pi,
+        eq.twist,
+        if eq.stable { "" } else { " (unstable)" }
+    )
 }
 
 /// The result: a single equilibrium in full, or the events of a branch and

@@ -29,9 +29,11 @@ pub enum CurveFileError {
 
 /// Read a curve file.
 pub fn read_points(path: &Path) -> Result<Vec<Vector3<f64>>, CurveFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CurveFileError::Read {
-        path: path.into(),
-        source,
+    let text = crate::io::read_text(path, crate::io::DATA_FILE_LIMIT).map_err(|source| {
+        CurveFileError::Read {
+            path: path.into(),
+            source,
+        }
     })?;
     parse_points(&text).map_err(|source| CurveFileError::Parse {
         path: path.into(),

@@ -187,7 +187,8 @@ pub fn merge(parts: &[PathBuf]) -> Result<Map, MapFileError> {
     let mut head: Option<Partial> = None;
     let mut traced = None;
     for p in parts {
-        let text = std::fs::read_to_string(p).map_err(file_error("cannot read", p))?;
+        let text = crate::io::read_text(p, crate::io::DATA_FILE_LIMIT)
+            .map_err(file_error("cannot read", p))?;
         let part: Partial = serde_json::from_str(&text).map_err(|source| MapFileError::Format {
             what: "a partial map",
             path: p.clone(),

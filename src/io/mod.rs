@@ -4,6 +4,7 @@
 pub mod curve_file;
 pub mod error;
 pub mod export;
+pub mod fuzz;
 pub mod json;
 pub mod map_files;
 pub mod plot;
@@ -12,3 +13,38 @@ pub mod scene_file;
 pub mod summary;
 
 pub use error::IoError;
+
+/// Largest data file read whole (curves, summaries, restarts, recordings, maps).
+pub const DATA_FILE_LIMIT: u64 = 1_000_000_000;
+/// Largest scene file.
+pub const SCENE_FILE_LIMIT: u64 = 16_000_000;
+
+/// The bytes of `path`, refused past `limit` bytes before they are held: the
+/// file's size is checked first, and the read itself stops past the limit (a
+/// pipe or device has no size to check).
+pub fn read_limited(path: &std::path::Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let file = std::fs::File::open(path)?;
+    let too_big = |size: String| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("the file holds {size} bytes; the most read is {limit}"),
+        )
+    };
+    let len = file.metadata()?.len();
+    if len > limit {
+        return Err(too_big(len.to_string()));
+    }
+    let mut bytes = Vec::with_capacity(len as usize);
+    file.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_big(format!("more than {limit}")));
+    }
+    Ok(bytes)
+}
+
+/// The text of `path` (UTF-8), refused past `limit` bytes (`read_limited`).
+pub fn read_text(path: &std::path::Path, limit: u64) -> std::io::Result<String> {
+    String::from_utf8(read_limited(path, limit)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error()))
+}

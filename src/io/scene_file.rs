@@ -11,9 +11,11 @@ use std::path::Path;
 impl Scene {
     /// Read and validate a scene file, with its restart state if it has one.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-            path: path.into(),
-            source,
+        let text = crate::io::read_text(path, crate::io::SCENE_FILE_LIMIT).map_err(|source| {
+            SceneError::Io {
+                path: path.into(),
+                source,
+            }
         })?;
         let mut scene = Scene::parse(&text).map_err(|e| match e {
             SceneError::Parse { message, .. } => SceneError::Parse {
@@ -57,7 +59,7 @@ fn restart_state(scene: &Scene) -> Result<Option<RodState>, SceneError> {
     let Some(path) = &init.file else {
         return Err(invalid("initial.file", "missing".into()));
     };
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    let text = crate::io::read_text(path, crate::io::DATA_FILE_LIMIT).map_err(|e| {
         invalid(
             "initial.file",
             format!("cannot read {}: {e}", path.display()),

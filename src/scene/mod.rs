@@ -3,10 +3,13 @@
 //! by section (`validate.rs`), errors naming the field. Files are read in
 //! `io::scene_file`.
 
+mod budget;
 pub(crate) mod exact;
+mod limits;
 mod map;
 mod validate;
 
+pub use limits::{BudgetSpec, Estimate, Job, human_time};
 pub use map::{MapSpec, SliceSpec};
 
 use crate::analysis::class::{Clearance, GoodKnot};
@@ -67,6 +70,9 @@ pub struct Scene {
     /// Outputs.
     #[serde(default)]
     pub output: OutputSpec,
+    /// `[budget]`: the largest predicted run started without `--allow-large`.
+    #[serde(default)]
+    pub budget: BudgetSpec,
 }
 
 /// `[model]`
@@ -415,11 +421,12 @@ pub struct OutputSpec {
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The file could not be read.
-    #[error("cannot read scene {path}: {source}")]
+    #[error("cannot read scene {path}")]
     Io {
         /// Path.
         path: PathBuf,
         /// Cause.
+        #[source]
         source: std::io::Error,
     },
     /// TOML syntax or an unknown/mistyped field.
@@ -437,6 +444,23 @@ pub enum SceneError {
         field: &'static str,
         /// What is wrong.
         reason: String,
+    },
+    /// The predicted work or memory exceeds the scene's budget.
+    #[error(
+        "this scene would need about {estimate} of {what} ({drivers}), over the budget of \
+         {limit}: pass --allow-large to run it anyway, or raise `{key}` in the scene"
+    )]
+    TooLarge {
+        /// "memory" or "CPU time".
+        what: &'static str,
+        /// The estimate, with its unit.
+        estimate: String,
+        /// The settings and counts it comes from.
+        drivers: String,
+        /// The limit, with its unit.
+        limit: String,
+        /// The scene key that raises the limit.
+        key: &'static str,
     },
 }
 

@@ -19,6 +19,7 @@ impl Scene {
         self.check_diagnostics()?;
         self.check_stability()?;
         self.check_reference()?;
+        self.check_budget_spec()?;
         Ok(())
     }
 
@@ -132,6 +133,12 @@ impl Scene {
         }
         for v in i.bump.iter().flatten() {
             finite("initial.bump", *v)?;
+            if v.abs() > 10.0 {
+                return Err(invalid(
+                    "initial.bump",
+                    format!("each component must be in [-10, 10] (rod lengths), got {v}"),
+                ));
+            }
         }
         if i.shape == InitialShape::File && i.file.is_none() {
             return Err(invalid("initial.file", "required for shape = \"file\""));

@@ -216,6 +216,7 @@ impl<'a> Tracer<'a> {
         }
         let max_diag = energy.pattern.max_abs_diagonal(&self.values);
         let (rel, at_floor) = residual(&info, gnorm, max_diag, state, n);
+        crate::linalg::counters::set_residual(rel);
         let factored = match &mut self.kkt {
             Some(k) => k.ldlt.factor(&k.values),
             None => self.newton.ldlt.factor(&self.values),

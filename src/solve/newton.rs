@@ -6,7 +6,7 @@ use crate::linalg::eigen::lowest_eigenvalues;
 use crate::linalg::sparse::Ldlt;
 use crate::model::energy::{GradientInfo, RodEnergy};
 use crate::model::rod::RodState;
-use crate::solve::outcome::{SolveError, SolveReport, SolverSettings, armijo, residual};
+use crate::solve::outcome::{SolveError, SolveReport, SolverSettings, armijo, residual, stalled};
 
 /// Work vectors of Newton's method on one energy's pattern (allocated once,
 /// reused by every iteration and solve).
@@ -78,13 +78,15 @@ impl Newton {
                 iteration,
             });
         }
-        let (rel, at_floor) = residual(
-            &info,
-            gnorm,
-            self.max_diagonal(energy),
-            state,
-            self.grad.len(),
-        );
+        let max_diagonal = self.max_diagonal(energy);
+        let (rel, at_floor) = residual(&info, gnorm, max_diagonal, state, self.grad.len());
+        crate::linalg::counters::set_residual(rel);
+        if stalled(gnorm, rel, max_diagonal, state, self.grad.len()) {
+            return Err(SolveError::RoundOff {
+                iteration,
+                residual: rel,
+            });
+        }
         Ok((info, rel, at_floor))
     }
 

@@ -106,6 +106,19 @@ pub enum SolveError {
         /// At which iteration.
         iteration: usize,
     },
+    /// The gradient reached its round-off floor far from an equilibrium.
+    #[error(
+        "the gradient reached its round-off floor at Newton iteration {iteration} with the \
+         relative gradient still {residual:.3e} (> 1e-6): this N and stiffness are past what \
+         f64 resolves (stiffness ratio × N² ≳ 1e15); use fewer segments or a smaller \
+         stretching stiffness (larger model.rod_diameter)"
+    )]
+    RoundOff {
+        /// At which iteration.
+        iteration: usize,
+        /// Relative gradient there.
+        residual: f64,
+    },
     /// The line search could not decrease the energy.
     #[error(
         "line search failed at Newton iteration {iteration} (relative gradient {residual:.3e})"
@@ -156,5 +169,19 @@ pub fn residual(
     };
     let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
     let floor = 16.0 * f64::EPSILON * max_diagonal * extent.max(1e-3) * (dofs as f64).sqrt();
-    (rel, gnorm <= floor)
+    // a floor above a relative gradient of 1e-6 is not an equilibrium to
+    // trust: the problem is past what f64 resolves (see `stalled`)
+    (rel, gnorm <= floor && rel <= FLOOR_TRUST)
+}
+
+/// The largest relative gradient accepted at the round-off floor.
+pub const FLOOR_TRUST: f64 = 1e-6;
+
+/// Whether the gradient is at its round-off floor while the relative
+/// gradient is still above `FLOOR_TRUST`: no step can improve it, and the
+/// state is no equilibrium worth reporting.
+pub fn stalled(gnorm: f64, rel: f64, max_diagonal: f64, state: &RodState, dofs: usize) -> bool {
+    let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
+    let floor = 16.0 * f64::EPSILON * max_diagonal * extent.max(1e-3) * (dofs as f64).sqrt();
+    gnorm <= floor && rel > FLOOR_TRUST
 }

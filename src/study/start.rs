@@ -185,10 +185,70 @@ pub fn starting_equilibrium(
         return Ok((newton, state, report));
     }
     let mut state = initial_state(scene, &model)?;
+    check_start(scene, &newton.energy, &state)?;
     let report = newton
         .minimize(&mut state, &scene.solver)
         .context("Newton minimisation")?;
     Ok((newton, state, report))
+}
+
+/// The scene field a start shape comes from.
+fn start_field(init: &InitialSpec) -> &'static str {
+    if init.from_recording.is_some() {
+        return "initial.from_recording";
+    }
+    match init.shape {
+        InitialShape::Straight if init.bump.is_some() => "initial.bump",
+        InitialShape::Straight | InitialShape::DoubleRing | InitialShape::Trefoil => {
+            "initial.shape"
+        }
+        InitialShape::Shooting => "initial.n0, initial.m0",
+        InitialShape::File => "initial.file",
+    }
+}
+
+/// A start the solver can begin from: finite coordinates (else the start's
+/// field is named) and a finite energy and gradient (else the stiffnesses
+/// that scale them are), so that no NaN surfaces later as a solver failure
+/// naming no input.
+fn check_start(scene: &Scene, energy: &RodEnergy, state: &RodState) -> Result<()> {
+    let finite = state.nodes.iter().all(|x| x.iter().all(|v| v.is_finite()))
+        && state.theta.iter().all(|v| v.is_finite())
+        && state
+            .reference
+            .iter()
+            .all(|x| x.iter().all(|v| v.is_finite()))
+        && state.reference_twist.iter().all(|v| v.is_finite())
+        && state.multipliers.iter().all(|v| v.is_finite());
+    if !finite {
+        fail!(
+            "{}: the start shape has non-finite coordinates (an integration or a file past \
+             f64's range): give smaller values",
+            start_field(&scene.initial)
+        );
+    }
+    let mut gradient = vec![0.0; energy.map.len()];
+    let mut hessian = vec![0.0; energy.pattern.nnz()];
+    let e = energy.hessian(state, &mut gradient, &mut hessian).energy;
+    // the norm too: finite entries can still square past f64's range
+    let norm = gradient.iter().map(|g| g * g).sum::<f64>();
+    if !e.is_finite()
+        || !norm.is_finite()
+        || gradient.iter().any(|g| !g.is_finite())
+        || hessian.iter().any(|h| !h.is_finite())
+    {
+        let m = &scene.model;
+        fail!(
+            "the start ({}) has a non-finite energy, gradient or Hessian with model.K2 = {}, model.K3 = {}, \
+             stretching stiffness {:.3e} (model.stretching_stiffness or model.rod_diameter): \
+             the start is too far stretched or the stiffnesses too large for f64",
+            start_field(&scene.initial),
+            m.k2,
+            m.k3,
+            energy.model.stretching_stiffness
+        );
+    }
+    Ok(())
 }
 
 /// Solve a scene's single equilibrium at N segments (the scene's own N if None).

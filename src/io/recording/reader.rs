@@ -20,7 +20,8 @@ pub struct Recording {
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(IoError::file("cannot read recording", path))
+    crate::io::read_limited(path, crate::io::DATA_FILE_LIMIT)
+        .map_err(IoError::file("cannot read recording", path))
 }
 
 /// The error for an MCAP file that cannot be parsed.
@@ -93,9 +94,14 @@ fn each_record(path: &Path, bytes: &[u8], mut on: impl FnMut(Item) -> Result<()>
 
 /// Read scalars, events, metadata and channel counts of a recording.
 pub fn read_recording(path: &Path) -> Result<Recording> {
-    let bytes = read_bytes(path)?;
+    parse_recording(path, &read_bytes(path)?)
+}
+
+/// Scalars, events, metadata and channel counts of a recording's `bytes`
+/// (`path` names it in errors).
+pub fn parse_recording(path: &Path, bytes: &[u8]) -> Result<Recording> {
     let mut rec = Recording::default();
-    each_record(path, &bytes, |item| {
+    each_record(path, bytes, |item| {
         match item {
             Item::Message { topic, data } => {
                 *rec.channels.entry(topic.to_string()).or_insert(0) += 1;
@@ -121,9 +127,14 @@ pub fn read_recording(path: &Path) -> Result<Recording> {
 
 /// The state with index `index` of a recording, with its model.
 pub fn read_state(path: &Path, index: u64) -> Result<StateMessage> {
-    let bytes = read_bytes(path)?;
+    parse_state(path, &read_bytes(path)?, index)
+}
+
+/// The state with index `index` of a recording's `bytes` (`path` names it in
+/// errors).
+pub fn parse_state(path: &Path, bytes: &[u8], index: u64) -> Result<StateMessage> {
     let (mut count, mut found) = (0, None);
-    each_record(path, &bytes, |item| {
+    each_record(path, bytes, |item| {
         if let Item::Message {
             topic: STATE_TOPIC,
             data,
