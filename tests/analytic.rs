@@ -11,6 +11,7 @@ use std::f64::consts::PI;
 
 fn model(n: usize, k2: f64, k3: f64) -> RodModel {
     RodModel {
+        weight: [0.0; 3],
         segments: n,
         k2,
         k3,
@@ -109,4 +110,36 @@ fn clamped_rod_under_pure_twist_buckles_at_greenhill_moment() {
             "observed order {order} (errors {err:?})"
         );
     }
+}
+
+/// The midspan sag of a straight clamped-clamped rod (z* = 1) under a small
+/// transverse weight w along −x (isotropic, B = 1), to compare with the
+/// beam's w L⁴ / (384 B).
+fn midspan_sag(n: usize, w: f64) -> f64 {
+    let text = format!(
+        "[model]\nsegments = {n}\nK2 = 1.0\nK3 = 1.0\n[clamps]\nz_star = 1.0\ndelta = 0.0\nphi_over_2pi = 0.0\n\
+         [solver]\ngradient_tol = 1e-12\n[load]\nweight = {w}\ndirection = [-1.0, 0.0, 0.0]\n"
+    );
+    let scene = knotrod::scene::Scene::parse(&text).unwrap();
+    let eq = knotrod::study::start::solve_scene(&scene, None).unwrap();
+    let x = &eq.state.nodes;
+    // nodes sit at s = (i − 1/2)/N: midspan between nodes N/2 and N/2 + 1
+    0.5 * (x[n / 2].x + x[n / 2 + 1].x)
+}
+
+#[test]
+fn a_clamped_clamped_rod_sags_under_its_weight_as_a_beam() {
+    let w = 1e-2;
+    let exact = -w / 384.0;
+    let errors: Vec<f64> = [20, 40, 80]
+        .iter()
+        .map(|&n| (midspan_sag(n, w) - exact).abs() / exact.abs())
+        .collect();
+    eprintln!("sag vs w/384, N = 20, 40, 80: relative errors {errors:?}");
+    // second order in N
+    for k in 0..2 {
+        let order = (errors[k] / errors[k + 1]).log2();
+        assert!(order > 1.8, "errors {errors:?}, order {order}");
+    }
+    assert!(errors[2] < 1e-3, "errors {errors:?}");
 }

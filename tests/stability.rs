@@ -84,6 +84,7 @@ fn stable_knot_spectrum_matches_dense() {
 fn stable_knot(n: usize) {
     // the Appendix D knot at a coarse N, relaxed
     let model = RodModel {
+        weight: [0.0; 3],
         segments: n,
         k2: 3.0,
         k3: 3.0,
@@ -111,6 +112,7 @@ fn unstable_state_spectrum_matches_dense() {
     // straight rod twisted well past the Greenhill moment: an unstable equilibrium
     for n in [20, 60] {
         let model = RodModel {
+            weight: [0.0; 3],
             segments: n,
             k2: 1.0,
             k3: 1.0,

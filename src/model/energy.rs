@@ -24,6 +24,8 @@ pub struct Terms {
     pub twisting: bool,
     /// Stretching penalty, 1/2 ∫ S (|r'| - 1)².
     pub stretching: bool,
+    /// The weight, −∫ w g·r ds.
+    pub gravity: bool,
 }
 
 impl Terms {
@@ -32,24 +34,35 @@ impl Terms {
         bending: true,
         twisting: true,
         stretching: true,
+        gravity: true,
     };
     /// Bending only.
     pub const BENDING: Terms = Terms {
         bending: true,
         twisting: false,
         stretching: false,
+        gravity: false,
     };
     /// Twisting only.
     pub const TWISTING: Terms = Terms {
         bending: false,
         twisting: true,
         stretching: false,
+        gravity: false,
     };
     /// Stretching only.
     pub const STRETCHING: Terms = Terms {
         bending: false,
         twisting: false,
         stretching: true,
+        gravity: false,
+    };
+    /// The weight only.
+    pub const GRAVITY: Terms = Terms {
+        bending: false,
+        twisting: false,
+        stretching: false,
+        gravity: true,
     };
 }
 
@@ -499,7 +512,45 @@ impl RodEnergy {
                 e += stretching_energy(&edge_variables(state, j), &self.model);
             }
         }
+        if self.terms.gravity {
+            e += self.gravity_energy(state);
+        }
         e
+    }
+
+    /// The weight's potential energy −∫ w g·r ds, by the midpoint rule on
+    /// the nodes x_1..x_N (node i stands for s ∈ [(i−1)h, ih]).
+    pub fn gravity_energy(&self, state: &RodState) -> f64 {
+        let w = Vector3::from(self.model.weight);
+        let h = self.model.segment_length();
+        -h * (1..=self.model.segments)
+            .map(|i| w.dot(&state.nodes[i]))
+            .sum::<f64>()
+    }
+
+    /// The weight's force on node i (its gradient is −h w g on each of
+    /// x_1..x_N, its Hessian zero).
+    fn gravity_gradient(&self) -> Vector3<f64> {
+        -self.model.segment_length() * Vector3::from(self.model.weight)
+    }
+
+    /// Add the weight's gradient on the free translations; returns its
+    /// squared norm (for the force scale).
+    fn scatter_gravity(&self, grad: &mut [f64]) -> f64 {
+        let g = self.gravity_gradient();
+        let mut scale2 = 0.0;
+        if g == Vector3::zeros() {
+            return 0.0;
+        }
+        for i in 1..=self.model.segments {
+            if let Some(d) = self.map.node(i) {
+                for k in 0..3 {
+                    grad[d + k] += g[k];
+                    scale2 += g[k] * g[k];
+                }
+            }
+        }
+        scale2
     }
 
     /// Energy, node-variable gradient and Hessian (row-major 11×11) of the
@@ -581,6 +632,12 @@ impl RodEnergy {
                 g.nodes[j + 1] += Vector3::new(gl[3], gl[4], gl[5]);
             }
         }
+        if self.terms.gravity {
+            let w = self.gravity_gradient();
+            for x in &mut g.nodes[1..=n] {
+                *x += w;
+            }
+        }
         g
     }
 
@@ -602,6 +659,10 @@ impl RodEnergy {
                 energy += e;
                 scale2 += scatter(&self.map.edge_stencil(j), &gl, grad);
             }
+        }
+        if self.terms.gravity {
+            energy += self.gravity_energy(state);
+            scale2 += self.scatter_gravity(grad);
         }
         GradientInfo {
             energy,
@@ -638,6 +699,10 @@ impl RodEnergy {
                 scale2 += scatter(&self.map.edge_stencil(j), &gl, grad);
                 scatter_hessian(&self.pattern.slots[n + j - 1], 6, &hl, values);
             }
+        }
+        if self.terms.gravity {
+            energy += self.gravity_energy(state);
+            scale2 += self.scatter_gravity(grad);
         }
         GradientInfo {
             energy,

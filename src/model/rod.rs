@@ -37,6 +37,10 @@ pub struct RodModel {
     /// Constitutive law of bending and twisting.
     #[serde(default)]
     pub law: Law,
+    /// Body force per unit length, w g (in units of B11 / L³): the weight of
+    /// the rod with its direction; potential energy −∫ w g·r ds.
+    #[serde(default)]
+    pub weight: [f64; 3],
 }
 
 /// Constitutive law of bending and twisting (energy per unit length, in units
@@ -84,13 +88,25 @@ impl RodModel {
 
     /// One line naming the law and its stiffness ratios.
     pub fn describe(&self) -> String {
-        match self.law {
+        let law = match self.law {
             Law::Kirchhoff => format!("Kirchhoff rod, K2 = {}, K3 = {}", self.k2, self.k3),
             Law::Unbendable => format!("Kirchhoff rod with u2 = 0 (K2 → ∞), K3 = {}", self.k3),
             Law::Strip { regularisation } => {
                 format!("elastic strip (Sadowsky, u2 = 0), ε = {regularisation}")
             }
+        };
+        let w = Vector3::from(self.weight);
+        if w == Vector3::zeros() {
+            return law;
         }
+        let g = w.normalize();
+        format!(
+            "{law}, weight w L³/B = {} along ({:.3}, {:.3}, {:.3})",
+            w.norm(),
+            g.x,
+            g.y,
+            g.z
+        )
     }
 
     /// Stretching stiffness of a solid circular rod of the given diameter: 16/d².

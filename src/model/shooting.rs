@@ -15,6 +15,12 @@ fn part(y: &OdeState, k: usize) -> Vector3<f64> {
 
 /// Right-hand side of (A.2) for K2, K3 (B11 = 1, no external force).
 pub fn rhs(y: &OdeState, k2: f64, k3: f64) -> OdeState {
+    rhs_loaded(y, k2, k3, &Vector3::zeros())
+}
+
+/// Right-hand side of (A.2) with a body force `weight` = w g per unit length
+/// (lab frame): n' = n × u − f in material components, f_i = w g·d_i.
+pub fn rhs_loaded(y: &OdeState, k2: f64, k3: f64, weight: &Vector3<f64>) -> OdeState {
     let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
     let n = part(y, 4);
     let m = part(y, 5);
@@ -29,8 +35,9 @@ pub fn rhs(y: &OdeState, k2: f64, k3: f64) -> OdeState {
     set(&mut f, 1, u[2] * d2 - u[1] * d3);
     set(&mut f, 2, u[0] * d3 - u[2] * d1);
     set(&mut f, 3, u[1] * d1 - u[0] * d2);
-    // n' = n × u, m' = m × u + n × d3 (components in the material frame)
-    set(&mut f, 4, n.cross(&u));
+    // n' = n × u − f, m' = m × u + n × d3 (components in the material frame)
+    let load = Vector3::new(weight.dot(&d1), weight.dot(&d2), weight.dot(&d3));
+    set(&mut f, 4, n.cross(&u) - load);
     set(&mut f, 5, m.cross(&u) + Vector3::new(n[1], -n[0], 0.0));
     f[18] = u[2];
     f
@@ -45,11 +52,26 @@ pub struct ShootingSolution {
     pub k2: f64,
     /// Twisting ratio.
     pub k3: f64,
+    /// Body force per unit length (lab frame).
+    pub weight: Vector3<f64>,
 }
 
 impl ShootingSolution {
     /// Integrate from r = 0, d_i = e_i, with n(0), m(0) in the material frame.
     pub fn integrate(n0: Vector3<f64>, m0: Vector3<f64>, k2: f64, k3: f64, steps: usize) -> Self {
+        Self::integrate_loaded(n0, m0, k2, k3, Vector3::zeros(), steps)
+    }
+
+    /// As `integrate`, under a body force `weight` per unit length (lab frame).
+    pub fn integrate_loaded(
+        n0: Vector3<f64>,
+        m0: Vector3<f64>,
+        k2: f64,
+        k3: f64,
+        weight: Vector3<f64>,
+        steps: usize,
+    ) -> Self {
+        let f = |y: &OdeState| rhs_loaded(y, k2, k3, &weight);
         let mut y = OdeState::zeros();
         y[3] = 1.0;
         y[7] = 1.0;
@@ -62,14 +84,19 @@ impl ShootingSolution {
         let mut samples = Vec::with_capacity(steps + 1);
         samples.push(y);
         for _ in 0..steps {
-            let a = rhs(&y, k2, k3);
-            let b = rhs(&(y + 0.5 * ds * a), k2, k3);
-            let c = rhs(&(y + 0.5 * ds * b), k2, k3);
-            let d = rhs(&(y + ds * c), k2, k3);
+            let a = f(&y);
+            let b = f(&(y + 0.5 * ds * a));
+            let c = f(&(y + 0.5 * ds * b));
+            let d = f(&(y + ds * c));
             y += ds / 6.0 * (a + 2.0 * b + 2.0 * c + d);
             samples.push(y);
         }
-        ShootingSolution { samples, k2, k3 }
+        ShootingSolution {
+            samples,
+            k2,
+            k3,
+            weight,
+        }
     }
 
     /// State at s by cubic Hermite interpolation with the exact derivative (A.2).
@@ -80,7 +107,8 @@ impl ShootingSolution {
         let t = x - k as f64;
         let ds = 1.0 / steps as f64;
         let (y0, y1) = (&self.samples[k], &self.samples[k + 1]);
-        let (f0, f1) = (rhs(y0, self.k2, self.k3), rhs(y1, self.k2, self.k3));
+        let f = |y: &OdeState| rhs_loaded(y, self.k2, self.k3, &self.weight);
+        let (f0, f1) = (f(y0), f(y1));
         let h00 = 2.0 * t * t * t - 3.0 * t * t + 1.0;
         let h10 = t * t * t - 2.0 * t * t + t;
         let h01 = -2.0 * t * t * t + 3.0 * t * t;
@@ -137,13 +165,27 @@ pub fn refine_shooting(
     clamps: &Clamps,
     steps: usize,
 ) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    refine_shooting_loaded(n0, m0, k2, k3, Vector3::zeros(), clamps, steps)
+}
+
+/// As `refine_shooting`, under a body force `weight` per unit length.
+pub fn refine_shooting_loaded(
+    n0: Vector3<f64>,
+    m0: Vector3<f64>,
+    k2: f64,
+    k3: f64,
+    weight: Vector3<f64>,
+    clamps: &Clamps,
+    steps: usize,
+) -> Option<(Vector3<f64>, Vector3<f64>)> {
     let mut p = Vector6::new(n0[0], n0[1], n0[2], m0[0], m0[1], m0[2]);
     let res = |p: &Vector6<f64>| {
-        ShootingSolution::integrate(
+        ShootingSolution::integrate_loaded(
             p.fixed_rows::<3>(0).into(),
             p.fixed_rows::<3>(3).into(),
             k2,
             k3,
+            weight,
             steps,
         )
         .boundary_residual(clamps)

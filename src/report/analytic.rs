@@ -46,6 +46,7 @@ fn loss_of_stability(
 /// shortening (continuum: 4π²).
 pub fn euler_buckling_load(n: usize, stretching_stiffness: f64) -> Result<f64> {
     let model = RodModel {
+        weight: [0.0; 3],
         segments: n,
         k2: 1.0,
         k3: 3.0,
@@ -67,6 +68,7 @@ pub fn euler_buckling_load(n: usize, stretching_stiffness: f64) -> Result<f64> {
 /// load (z* = 1) first becomes unstable as its clamp is rotated.
 pub fn greenhill_twisting_moment(n: usize, k3: f64, stretching_stiffness: f64) -> Result<f64> {
     let model = RodModel {
+        weight: [0.0; 3],
         segments: n,
         k2: 1.0,
         k3,

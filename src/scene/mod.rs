@@ -70,6 +70,9 @@ pub struct Scene {
     /// Outputs.
     #[serde(default)]
     pub output: OutputSpec,
+    /// `[load]`: the rod's weight.
+    #[serde(default)]
+    pub load: LoadSpec,
     /// `[budget]`: the largest predicted run started without `--allow-large`.
     #[serde(default)]
     pub budget: BudgetSpec,
@@ -378,6 +381,44 @@ impl Default for ContactSpec {
     }
 }
 
+/// `[load]`: the rod's weight per unit length, w L³ / B11 (for strips
+/// w L³ / B), acting along `direction`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// w L³ / B11 (0: no weight).
+    #[serde(default)]
+    pub weight: f64,
+    /// The direction of gravity (normalised; default −e3).
+    #[serde(default = "default_gravity", deserialize_with = "exact::array")]
+    pub direction: [f64; 3],
+}
+
+impl Default for LoadSpec {
+    fn default() -> Self {
+        LoadSpec {
+            weight: 0.0,
+            direction: default_gravity(),
+        }
+    }
+}
+
+fn default_gravity() -> [f64; 3] {
+    [0.0, 0.0, -1.0]
+}
+
+impl LoadSpec {
+    /// The body force per unit length, w g.
+    pub fn weight_vector(&self) -> [f64; 3] {
+        let d = nalgebra::Vector3::from(self.direction);
+        let n = d.norm();
+        if self.weight == 0.0 || n == 0.0 {
+            return [0.0; 3];
+        }
+        (d * (self.weight / n)).into()
+    }
+}
+
 /// `[reference]`: published values for comparison.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -535,6 +576,7 @@ impl Scene {
     pub fn rod_model(&self, segments: Option<usize>) -> RodModel {
         let m = &self.model;
         RodModel {
+            weight: self.load.weight_vector(),
             segments: segments.unwrap_or(m.segments as usize),
             k2: m.k2,
             k3: m.k3,

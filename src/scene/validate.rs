@@ -20,6 +20,7 @@ impl Scene {
         self.check_stability()?;
         self.check_reference()?;
         self.check_budget_spec()?;
+        self.check_load()?;
         Ok(())
     }
 
@@ -37,6 +38,26 @@ impl Scene {
                     finite(field, v)?;
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// `[load]`: a finite weight of sensible size along a non-zero direction.
+    fn check_load(&self) -> Result<(), SceneError> {
+        let l = &self.load;
+        finite("load.weight", l.weight)?;
+        if l.weight.abs() > 1e4 {
+            return Err(invalid(
+                "load.weight",
+                format!("|w L³ / B| must be <= 1e4, got {}", l.weight),
+            ));
+        }
+        for v in l.direction {
+            finite("load.direction", v)?;
+        }
+        let n = l.direction.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if l.weight != 0.0 && n < 1e-12 {
+            return Err(invalid("load.direction", "must be a non-zero vector"));
         }
         Ok(())
     }

@@ -5,7 +5,7 @@ use crate::analysis::class::is_trefoil;
 use crate::analysis::equilibrium::{Conformation, Equilibrium, analyse};
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
-use crate::model::shooting::{ShootingSolution, refine_shooting};
+use crate::model::shooting::{ShootingSolution, refine_shooting_loaded};
 use crate::scene::{InitialShape, InitialSpec, Scene, SceneError};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
@@ -110,11 +110,12 @@ fn shooting(init: &InitialSpec, model: &RodModel, clamps: Clamps) -> Result<RodS
         Vector3::from(init.m0.context("initial.m0 missing")?),
     );
     let steps = init.steps.map_or(20_000, |s| s as usize);
+    let weight = Vector3::from(model.weight);
     if init.refine {
-        (n0, m0) = refine_shooting(n0, m0, model.k2, model.k3, &clamps, steps)
+        (n0, m0) = refine_shooting_loaded(n0, m0, model.k2, model.k3, weight, &clamps, steps)
             .context("initial.refine: shooting refinement did not converge")?;
     }
-    let sol = ShootingSolution::integrate(n0, m0, model.k2, model.k3, steps);
+    let sol = ShootingSolution::integrate_loaded(n0, m0, model.k2, model.k3, weight, steps);
     Ok(RodState::from_curve(
         model.segments,
         clamps,

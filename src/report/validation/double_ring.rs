@@ -42,6 +42,7 @@ fn critical_k(n: usize) -> Result<f64> {
     let (_, ring, _) = crate::study::start::starting_equilibrium(&scene, None)?;
     let lowest = |k: f64| -> Result<f64> {
         let energy = RodEnergy::new(RodModel {
+            weight: [0.0; 3],
             segments: n,
             k2: k,
             k3: k,
