@@ -16,6 +16,7 @@ fn random_state_with(n: usize, seed: u64, law: Law) -> (RodModel, RodState) {
     let model = RodModel {
         // a weight in a direction of no symmetry
         weight: [0.7, -1.9, 2.6],
+        natural_strains: [0.4, -0.9, 1.3],
         segments: n,
         k2: 2.3,
         k3: 1.7,

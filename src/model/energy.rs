@@ -377,12 +377,16 @@ fn energy_of_strains<T: Scalar>(
             }
         }
         law => {
+            // strains relative to the natural ones (integrated over h)
+            let [n1, n2, n3] = model.natural_strains.map(|v| T::from(v * h));
             if terms.bending {
                 let k2_stiffness = if law == Law::Kirchhoff { model.k2 } else { 0.0 };
-                e += (u.k1 * u.k1 + u.k2 * u.k2 * k2_stiffness) * (0.5 / h);
+                let (a1, a2) = (u.k1 - n1, u.k2 - n2);
+                e += (a1 * a1 + a2 * a2 * k2_stiffness) * (0.5 / h);
             }
             if terms.twisting {
-                e += u.m * u.m * (0.5 * model.k3 / h);
+                let a3 = u.m - n3;
+                e += a3 * a3 * (0.5 * model.k3 / h);
             }
         }
     }

@@ -41,6 +41,10 @@ pub struct RodModel {
     /// the rod with its direction; potential energy −∫ w g·r ds.
     #[serde(default)]
     pub weight: [f64; 3],
+    /// Natural strains (û1, û2, û3), constant along the rod: the energy is
+    /// ½ ∫ B_i (u_i − û_i)² (zero: a naturally straight, untwisted rod).
+    #[serde(default)]
+    pub natural_strains: [f64; 3],
 }
 
 /// Constitutive law of bending and twisting (energy per unit length, in units
@@ -95,18 +99,23 @@ impl RodModel {
                 format!("elastic strip (Sadowsky, u2 = 0), ε = {regularisation}")
             }
         };
-        let w = Vector3::from(self.weight);
-        if w == Vector3::zeros() {
-            return law;
+        let mut out = law;
+        let u = self.natural_strains;
+        if u != [0.0; 3] {
+            out += &format!(", natural strains û = ({}, {}, {})", u[0], u[1], u[2]);
         }
-        let g = w.normalize();
-        format!(
-            "{law}, weight w L³/B = {} along ({:.3}, {:.3}, {:.3})",
-            w.norm(),
-            g.x,
-            g.y,
-            g.z
-        )
+        let w = Vector3::from(self.weight);
+        if w != Vector3::zeros() {
+            let g = w.normalize();
+            out += &format!(
+                ", weight w L³/B = {} along ({:.3}, {:.3}, {:.3})",
+                w.norm(),
+                g.x,
+                g.y,
+                g.z
+            );
+        }
+        out
     }
 
     /// Stretching stiffness of a solid circular rod of the given diameter: 16/d².

@@ -15,16 +15,23 @@ fn part(y: &OdeState, k: usize) -> Vector3<f64> {
 
 /// Right-hand side of (A.2) for K2, K3 (B11 = 1, no external force).
 pub fn rhs(y: &OdeState, k2: f64, k3: f64) -> OdeState {
-    rhs_loaded(y, k2, k3, &Vector3::zeros())
+    rhs_loaded(y, k2, k3, &Vector3::zeros(), &Vector3::zeros())
 }
 
 /// Right-hand side of (A.2) with a body force `weight` = w g per unit length
-/// (lab frame): n' = n × u − f in material components, f_i = w g·d_i.
-pub fn rhs_loaded(y: &OdeState, k2: f64, k3: f64, weight: &Vector3<f64>) -> OdeState {
+/// (lab frame): n' = n × u − f in material components, f_i = w g·d_i; and
+/// natural strains û: u = B⁻¹m + û.
+pub fn rhs_loaded(
+    y: &OdeState,
+    k2: f64,
+    k3: f64,
+    weight: &Vector3<f64>,
+    natural: &Vector3<f64>,
+) -> OdeState {
     let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
     let n = part(y, 4);
     let m = part(y, 5);
-    let u = Vector3::new(m[0], m[1] / k2, m[2] / k3);
+    let u = Vector3::new(m[0], m[1] / k2, m[2] / k3) + natural;
     let mut f = OdeState::zeros();
     let set = |f: &mut OdeState, k: usize, v: Vector3<f64>| {
         f[3 * k] = v[0];
@@ -54,24 +61,28 @@ pub struct ShootingSolution {
     pub k3: f64,
     /// Body force per unit length (lab frame).
     pub weight: Vector3<f64>,
+    /// Natural strains û.
+    pub natural: Vector3<f64>,
 }
 
 impl ShootingSolution {
     /// Integrate from r = 0, d_i = e_i, with n(0), m(0) in the material frame.
     pub fn integrate(n0: Vector3<f64>, m0: Vector3<f64>, k2: f64, k3: f64, steps: usize) -> Self {
-        Self::integrate_loaded(n0, m0, k2, k3, Vector3::zeros(), steps)
+        Self::integrate_loaded(n0, m0, k2, k3, Vector3::zeros(), Vector3::zeros(), steps)
     }
 
-    /// As `integrate`, under a body force `weight` per unit length (lab frame).
+    /// As `integrate`, under a body force `weight` per unit length (lab
+    /// frame), for a rod of natural strains `natural`.
     pub fn integrate_loaded(
         n0: Vector3<f64>,
         m0: Vector3<f64>,
         k2: f64,
         k3: f64,
         weight: Vector3<f64>,
+        natural: Vector3<f64>,
         steps: usize,
     ) -> Self {
-        let f = |y: &OdeState| rhs_loaded(y, k2, k3, &weight);
+        let f = |y: &OdeState| rhs_loaded(y, k2, k3, &weight, &natural);
         let mut y = OdeState::zeros();
         y[3] = 1.0;
         y[7] = 1.0;
@@ -96,6 +107,7 @@ impl ShootingSolution {
             k2,
             k3,
             weight,
+            natural,
         }
     }
 
@@ -107,7 +119,7 @@ impl ShootingSolution {
         let t = x - k as f64;
         let ds = 1.0 / steps as f64;
         let (y0, y1) = (&self.samples[k], &self.samples[k + 1]);
-        let f = |y: &OdeState| rhs_loaded(y, self.k2, self.k3, &self.weight);
+        let f = |y: &OdeState| rhs_loaded(y, self.k2, self.k3, &self.weight, &self.natural);
         let (f0, f1) = (f(y0), f(y1));
         let h00 = 2.0 * t * t * t - 3.0 * t * t + 1.0;
         let h10 = t * t * t - 2.0 * t * t + t;
@@ -165,16 +177,25 @@ pub fn refine_shooting(
     clamps: &Clamps,
     steps: usize,
 ) -> Option<(Vector3<f64>, Vector3<f64>)> {
-    refine_shooting_loaded(n0, m0, k2, k3, Vector3::zeros(), clamps, steps)
+    refine_shooting_loaded(
+        n0,
+        m0,
+        k2,
+        k3,
+        [Vector3::zeros(), Vector3::zeros()],
+        clamps,
+        steps,
+    )
 }
 
-/// As `refine_shooting`, under a body force `weight` per unit length.
+/// As `refine_shooting`, under a body force and with natural strains
+/// (`[weight, natural]`).
 pub fn refine_shooting_loaded(
     n0: Vector3<f64>,
     m0: Vector3<f64>,
     k2: f64,
     k3: f64,
-    weight: Vector3<f64>,
+    [weight, natural]: [Vector3<f64>; 2],
     clamps: &Clamps,
     steps: usize,
 ) -> Option<(Vector3<f64>, Vector3<f64>)> {
@@ -186,6 +207,7 @@ pub fn refine_shooting_loaded(
             k2,
             k3,
             weight,
+            natural,
             steps,
         )
         .boundary_residual(clamps)

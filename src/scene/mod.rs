@@ -104,6 +104,10 @@ pub struct ModelSpec {
     /// Stretching stiffness EA L²/B11 (overrides the one from the diameter).
     #[serde(default)]
     pub stretching_stiffness: Option<f64>,
+    /// Natural strains (û1, û2, û3) in units of 1/L, constant along the rod
+    /// (Kirchhoff rods; û2 = 0 for the unbendable law).
+    #[serde(default, deserialize_with = "exact::array")]
+    pub natural_strains: [f64; 3],
 }
 
 fn default_strip_regularisation() -> f64 {
@@ -577,6 +581,7 @@ impl Scene {
         let m = &self.model;
         RodModel {
             weight: self.load.weight_vector(),
+            natural_strains: self.model.natural_strains,
             segments: segments.unwrap_or(m.segments as usize),
             k2: m.k2,
             k3: m.k3,

@@ -93,6 +93,27 @@ impl Scene {
                 ),
             ));
         }
+        for v in m.natural_strains {
+            finite("model.natural_strains", v)?;
+            if v.abs() > 1e3 {
+                return Err(invalid(
+                    "model.natural_strains",
+                    format!("each |û_i| must be <= 1e3 (per rod length), got {v}"),
+                ));
+            }
+        }
+        if m.natural_strains != [0.0; 3] && m.kind == crate::scene::ModelKind::Strip {
+            return Err(invalid(
+                "model.natural_strains",
+                "the strip law has no natural strains yet: use kind = \"kirchhoff\"",
+            ));
+        }
+        if m.natural_strains[1] != 0.0 && m.kind == crate::scene::ModelKind::Unbendable {
+            return Err(invalid(
+                "model.natural_strains",
+                "û2 must be 0 for the unbendable law (u2 = 0 is enforced)",
+            ));
+        }
         if let Some(s) = m.stretching_stiffness {
             positive("model.stretching_stiffness", s)?;
             if s > 1e12 {

@@ -110,12 +110,24 @@ fn shooting(init: &InitialSpec, model: &RodModel, clamps: Clamps) -> Result<RodS
         Vector3::from(init.m0.context("initial.m0 missing")?),
     );
     let steps = init.steps.map_or(20_000, |s| s as usize);
-    let weight = Vector3::from(model.weight);
+    let (weight, natural) = (
+        Vector3::from(model.weight),
+        Vector3::from(model.natural_strains),
+    );
     if init.refine {
-        (n0, m0) = refine_shooting_loaded(n0, m0, model.k2, model.k3, weight, &clamps, steps)
-            .context("initial.refine: shooting refinement did not converge")?;
+        (n0, m0) = refine_shooting_loaded(
+            n0,
+            m0,
+            model.k2,
+            model.k3,
+            [weight, natural],
+            &clamps,
+            steps,
+        )
+        .context("initial.refine: shooting refinement did not converge")?;
     }
-    let sol = ShootingSolution::integrate_loaded(n0, m0, model.k2, model.k3, weight, steps);
+    let sol =
+        ShootingSolution::integrate_loaded(n0, m0, model.k2, model.k3, weight, natural, steps);
     Ok(RodState::from_curve(
         model.segments,
         clamps,
