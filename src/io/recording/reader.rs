@@ -66,6 +66,22 @@ fn each_record(path: &Path, bytes: &[u8], mut on: impl FnMut(Item) -> Result<()>
                 rest = &rest[len..];
             }
             LinearReadEvent::Record { data, opcode } => {
+                use mcap::records::op;
+                // only the records read here are parsed, and their string and
+                // map lengths are checked against the record first: the
+                // parser reserves a declared length before reading it
+                if ![op::CHANNEL, op::MESSAGE, op::METADATA].contains(&opcode) {
+                    continue;
+                }
+                if !lengths_fit(opcode, data) {
+                    return Err(IoError::Recording {
+                        path: path.into(),
+                        reason: format!(
+                            "not a readable MCAP recording (a record of opcode {opcode:#04x} \
+                             declares a string or map longer than itself)"
+                        ),
+                    });
+                }
                 match mcap::parse_record(opcode, data).map_err(bad)? {
                     Record::Channel(c) => {
                         topics.insert(c.id, c.topic);
@@ -90,6 +106,38 @@ fn each_record(path: &Path, bytes: &[u8], mut on: impl FnMut(Item) -> Result<()>
         }
     }
     Ok(())
+}
+
+/// Whether the length-prefixed strings and maps of a Channel or Metadata
+/// record lie inside the record (Messages have none before their data).
+fn lengths_fit(opcode: u8, data: &[u8]) -> bool {
+    use mcap::records::op;
+    /// Skip a u32 length and that many bytes from `at`; None if past `end`.
+    fn skip(data: &[u8], at: usize, end: usize) -> Option<usize> {
+        let len = u32::from_le_bytes(data.get(at..at + 4)?.try_into().ok()?) as usize;
+        let next = (at + 4).checked_add(len)?;
+        (next <= end).then_some(next)
+    }
+    /// A map of strings: its byte length, then key and value strings.
+    fn map(data: &[u8], at: usize) -> Option<usize> {
+        let end = skip(data, at, data.len())?;
+        let mut k = at + 4;
+        while k < end {
+            k = skip(data, k, end)?;
+            k = skip(data, k, end)?;
+        }
+        (k == end).then_some(end)
+    }
+    let fits = match opcode {
+        // id u16, schema id u16, topic, message encoding, metadata
+        op::CHANNEL => skip(data, 4, data.len())
+            .and_then(|k| skip(data, k, data.len()))
+            .and_then(|k| map(data, k)),
+        // name, metadata
+        op::METADATA => skip(data, 0, data.len()).and_then(|k| map(data, k)),
+        _ => Some(0),
+    };
+    fits.is_some()
 }
 
 /// Read scalars, events, metadata and channel counts of a recording.
