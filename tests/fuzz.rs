@@ -180,15 +180,8 @@ fn inputs_the_long_fuzz_runs_found_are_answered() {
     // (was 6.5 s of polynomial arithmetic, a libFuzzer timeout)
     let b = std::fs::read("tests/fixtures/fuzz/knot_points_489_crossings").unwrap();
     fuzz::knot_points(&b);
-    let points: Vec<nalgebra::Vector3<f64>> = b
-        .chunks_exact(6)
-        .map(|c| {
-            let v = |k: usize| i16::from_le_bytes([c[k], c[k + 1]]) as f64 / 1000.0;
-            nalgebra::Vector3::new(v(0), v(2), v(4))
-        })
-        .collect();
     assert!(matches!(
-        knotrod::geometry::knot::knot_type(&points),
+        knotrod::geometry::knot::knot_type(&fuzz::points_of(&b)),
         Err(knotrod::geometry::knot::KnotError::TooManyCrossings(489))
     ));
     // 88 bytes whose record declares a 2.9 GB string: an error, no allocation

@@ -166,3 +166,36 @@ fn endless_files_are_refused_not_read() {
         "{err}"
     );
 }
+
+#[test]
+fn bad_values_of_the_new_settings_name_their_field() {
+    for (extra, field) in [
+        ("[budget]\nmemory_gb = -1.0\n", "budget.memory_gb"),
+        ("[budget]\nhours = nan\n", "budget.hours"),
+        ("[load]\nweight = 1e9\n", "load.weight"),
+        (
+            "[load]\nweight = 1.0\ndirection = [0.0, 0.0, 0.0]\n",
+            "load.direction",
+        ),
+        ("[load]\ndirection = [0.0, 1.0]\n", "direction"),
+    ] {
+        let e = Scene::parse(&format!("{SMALL}{extra}")).unwrap_err();
+        assert!(e.to_string().contains(field), "{extra}: {e}");
+    }
+    for (model, field) in [
+        ("natural_strains = [1e4, 0.0, 0.0]", "model.natural_strains"),
+        ("natural_strains = [1.0, 0.0]", "natural_strains"),
+        (
+            "kind = \"strip\"\nnatural_strains = [1.0, 0.0, 0.0]",
+            "model.natural_strains",
+        ),
+        (
+            "kind = \"unbendable\"\nnatural_strains = [0.0, 1.0, 0.0]",
+            "model.natural_strains",
+        ),
+    ] {
+        let text = SMALL.replace("segments = 100", &format!("segments = 100\n{model}"));
+        let e = Scene::parse(&text).unwrap_err();
+        assert!(e.to_string().contains(field), "{model}: {e}");
+    }
+}

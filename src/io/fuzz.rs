@@ -43,15 +43,18 @@ pub fn curve_text(data: &[u8]) {
 /// Points from raw bytes (three i16 per point, in units of 1/1000): many
 /// crossings, coincident points and collinear runs.
 pub fn knot_points(data: &[u8]) {
-    let points: Vec<Vector3<f64>> = data
-        .chunks_exact(6)
+    check_knot(&points_of(data));
+}
+
+/// The points `knot_points` reads from bytes (at most 2000).
+pub fn points_of(data: &[u8]) -> Vec<Vector3<f64>> {
+    data.chunks_exact(6)
         .take(MOST_POINTS)
         .map(|c| {
             let v = |k: usize| i16::from_le_bytes([c[k], c[k + 1]]) as f64 / 1000.0;
             Vector3::new(v(0), v(2), v(4))
         })
-        .collect();
-    check_knot(&points);
+        .collect()
 }
 
 /// The knot type of a closed curve, when one is found, is a knot's: its

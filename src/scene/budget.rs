@@ -96,7 +96,8 @@ impl Scene {
         Estimate {
             memory_bytes: workspace + held * STATE_BYTES * n + grid,
             memory_from: format!("N = {n} segments (model.segments), {memory_from}"),
-            seconds: start + unfold * POINT_SECONDS * n + points * POINT_SECONDS * n,
+            // `points` holds the unfolding steps already
+            seconds: start + points * POINT_SECONDS * n,
             work_from: format!("{work_from} at N = {n} segments"),
         }
     }

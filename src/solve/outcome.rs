@@ -167,11 +167,19 @@ pub fn residual(
     } else {
         0.0
     };
-    let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
-    let floor = 16.0 * f64::EPSILON * max_diagonal * extent.max(1e-3) * (dofs as f64).sqrt();
     // a floor above a relative gradient of 1e-6 is not an equilibrium to
     // trust: the problem is past what f64 resolves (see `stalled`)
-    (rel, gnorm <= floor && rel <= FLOOR_TRUST)
+    (
+        rel,
+        gnorm <= round_off_floor(max_diagonal, state, dofs) && rel <= FLOOR_TRUST,
+    )
+}
+
+/// The gradient norm below which no step can improve it: ε × largest
+/// stiffness × extent × √n.
+fn round_off_floor(max_diagonal: f64, state: &RodState, dofs: usize) -> f64 {
+    let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
+    16.0 * f64::EPSILON * max_diagonal * extent.max(1e-3) * (dofs as f64).sqrt()
 }
 
 /// The largest relative gradient accepted at the round-off floor.
@@ -181,7 +189,5 @@ pub const FLOOR_TRUST: f64 = 1e-6;
 /// gradient is still above `FLOOR_TRUST`: no step can improve it, and the
 /// state is no equilibrium worth reporting.
 pub fn stalled(gnorm: f64, rel: f64, max_diagonal: f64, state: &RodState, dofs: usize) -> bool {
-    let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
-    let floor = 16.0 * f64::EPSILON * max_diagonal * extent.max(1e-3) * (dofs as f64).sqrt();
-    gnorm <= floor && rel > FLOOR_TRUST
+    rel > FLOOR_TRUST && gnorm <= round_off_floor(max_diagonal, state, dofs)
 }
