@@ -22,40 +22,7 @@ fn rod(n: usize, model_extra: &str, extra: &str) -> String {
 /// The relative distance of the DER's (n(0), m(0)) at N = 50, 100, 200 from
 /// the shooting solution polished from the finest, and that solution's n(0).
 fn against_shooting(model_extra: &str, extra: &str) -> (Vec<f64>, Vector3<f64>) {
-    let solve = |n: usize| {
-        let scene = Scene::parse(&rod(n, model_extra, extra)).unwrap();
-        let eq = solve_scene(&scene, None).unwrap();
-        assert!(eq.converged);
-        let model = scene.rod_model(None);
-        (
-            Vector3::from(eq.n0),
-            Vector3::from(eq.m0),
-            scene.clamps(),
-            [
-                Vector3::from(model.weight),
-                Vector3::from(model.natural_strains),
-            ],
-        )
-    };
-    let runs: Vec<_> = [50, 100, 200].into_iter().map(solve).collect();
-    let (n0, m0, clamps, [weight, natural]) = runs[2];
-    let (ns, ms) = refine_shooting_loaded(n0, m0, 3.0, 2.0, [weight, natural], &clamps, 20_000)
-        .expect("shooting converges from the DER reactions");
-    let sol = ShootingSolution::integrate_loaded(ns, ms, 3.0, 2.0, weight, natural, 20_000);
-    assert!(sol.boundary_residual(&clamps).norm() < 1e-10);
-    let errors: Vec<f64> = runs
-        .iter()
-        .map(|(n, m, _, _)| ((n - ns).norm() + (m - ms).norm()) / (ns.norm() + ms.norm()))
-        .collect();
-    eprintln!(
-        "DER vs shooting ({model_extra} {extra}), N = 50, 100, 200: relative errors {errors:?}"
-    );
-    for k in 0..2 {
-        let order = (errors[k] / errors[k + 1]).log2();
-        assert!(order > 1.9, "errors {errors:?}, order {order}");
-    }
-    assert!(errors[2] < 1e-3, "errors {errors:?}");
-    (errors, ns)
+    against_shooting_general(|n| rod(n, model_extra, extra))
 }
 
 /// n(0) of the plain rod (no weight, naturally straight) at N = 200.
@@ -113,4 +80,173 @@ fn a_ring_of_natural_curvature_two_pi_rests_at_zero_energy() {
     for k in 0..2 {
         assert!(runs[k].1 / runs[k + 1].1 > 3.0, "{runs:?}");
     }
+}
+
+/// DER reactions (n(0), m(0)) at N = 50, 100, 200 of a scene against the
+/// shooting solution of the same clamps polished from the finest, with K2 = 3,
+/// K3 = 2; returns the relative errors.
+fn against_shooting_general(scene_of: impl Fn(usize) -> String) -> (Vec<f64>, Vector3<f64>) {
+    let solve = |n: usize| {
+        let scene = Scene::parse(&scene_of(n)).unwrap();
+        let eq = solve_scene(&scene, None).unwrap();
+        assert!(eq.converged, "N = {n}");
+        let model = scene.rod_model(None);
+        (
+            Vector3::from(eq.n0),
+            Vector3::from(eq.m0),
+            scene.clamps(),
+            [
+                Vector3::from(model.weight),
+                Vector3::from(model.natural_strains),
+            ],
+        )
+    };
+    let runs: Vec<_> = [50, 100, 200].into_iter().map(solve).collect();
+    let (n0, m0, clamps, loads) = runs[2];
+    let (ns, ms) = refine_shooting_loaded(n0, m0, 3.0, 2.0, loads, &clamps, 20_000)
+        .expect("shooting converges from the DER reactions");
+    let sol = ShootingSolution::integrate_from(&clamps, ns, ms, [3.0, 2.0], loads, 20_000);
+    assert!(sol.boundary_residual(&clamps).norm() < 1e-10);
+    let errors: Vec<f64> = runs
+        .iter()
+        .map(|(n, m, _, _)| ((n - ns).norm() + (m - ms).norm()) / (ns.norm() + ms.norm()))
+        .collect();
+    eprintln!("DER vs shooting, N = 50, 100, 200: relative errors {errors:?}");
+    for k in 0..2 {
+        let order = (errors[k] / errors[k + 1]).log2();
+        assert!(
+            order > 1.9 && order < 2.1,
+            "errors {errors:?}, order {order}"
+        );
+    }
+    assert!(errors[2] < 1e-3, "errors {errors:?}");
+    (errors, ns)
+}
+
+#[test]
+fn tilted_and_rotated_clamps_agree_with_shooting_at_second_order() {
+    // both clamps general: the s = 0 one moved and rotated by Euler angles,
+    // the s = 1 one shifted, rotated by an axis and angle, tilted and turned
+    against_shooting_general(|n| {
+        format!(
+            "[model]\nsegments = {n}\nK2 = 3.0\nK3 = 2.0\nstretching_stiffness = 1e7\n\
+             [clamps]\nz_star = 0.7\ndelta = 0.0\nphi_over_2pi = 0.15\nend_shift = [0.2, -0.1]\n\
+             end_rotation = {{ axis_angle = [1.0, 1.0, 0.0, 0.3] }}\nend_tilt = 0.4\nend_tilt_azimuth = 0.7\n\
+             [clamps.start]\nposition = [0.05, 0.0, -0.1]\nrotation = {{ euler_zyx = [0.3, -0.2, 0.1] }}\n\
+             turn_over_2pi = 0.05\n\
+             [initial]\nbump = [-0.1, 0.05, 0.0]\n[solver]\ngradient_tol = 1e-12\n"
+        )
+    });
+}
+
+#[test]
+fn a_rigidly_moved_knot_has_the_same_reactions_twist_energy_and_knot() {
+    use knotrod::model::rod::{Clamps, Orientation, StartClamp};
+    use nalgebra::{UnitQuaternion, Vector3};
+    // Appendix D, then the same clamps moved by one rigid motion (x ↦ Q x + p)
+    let paper = Scene::load(std::path::Path::new("scenes/appendix_d.toml")).unwrap();
+    let mut scene = paper.clone();
+    scene.model.segments = 100;
+    let reference = solve_scene(&scene, None).unwrap();
+    let q = UnitQuaternion::from_euler_angles(0.7, -0.4, 1.1);
+    let p = Vector3::new(0.3, -0.2, 0.5);
+    let c = scene.clamps();
+    let end = q * c.end_point() + p;
+    let mut moved = Clamps {
+        z_star: end.z,
+        delta: 0.0,
+        phi: c.phi,
+        ..c
+    };
+    moved.end.shift = [end.x, end.y];
+    moved.end.orientation = Orientation {
+        rotation: q,
+        ..Orientation::default()
+    };
+    moved.start = StartClamp {
+        position: p,
+        orientation: Orientation {
+            rotation: q,
+            ..Orientation::default()
+        },
+        turn: 0.0,
+    };
+    let [w, x, y, z] = [q.w, q.i, q.j, q.k];
+    let text = std::fs::read_to_string("scenes/appendix_d.toml").unwrap().replace(
+        "[clamps]\nz_star = 0.115\ndelta = 0.05\nphi_over_2pi = 0.802\n",
+        &format!(
+            "[clamps]\nz_star = {}\ndelta = 0.0\nphi_over_2pi = 0.802\nend_shift = [{}, {}]\n\
+             end_rotation = {{ quaternion = [{w}, {x}, {y}, {z}] }}\n\
+             [clamps.start]\nposition = [{}, {}, {}]\nrotation = {{ quaternion = [{w}, {x}, {y}, {z}] }}\n",
+            end.z, end.x, end.y, p.x, p.y, p.z
+        ),
+    );
+    let mut general = Scene::parse(&text).unwrap();
+    general.model.segments = 100;
+    assert!(!general.clamps().is_paper());
+    assert!((general.clamps().end_point() - moved.end_point()).norm() < 1e-15);
+    let eq = solve_scene(&general, None).unwrap();
+    assert!(eq.converged);
+    let rel = |a: [f64; 3], b: [f64; 3]| {
+        (Vector3::from(a) - Vector3::from(b)).norm() / Vector3::from(b).norm()
+    };
+    // the reactions are in the material frame at s = 0: invariant
+    assert!(
+        rel(eq.n0, reference.n0) < 1e-7,
+        "{:?} vs {:?}",
+        eq.n0,
+        reference.n0
+    );
+    assert!(
+        rel(eq.m0, reference.m0) < 1e-7,
+        "{:?} vs {:?}",
+        eq.m0,
+        reference.m0
+    );
+    assert!((eq.energy - reference.energy).abs() < 1e-8 * reference.energy);
+    assert!((eq.twist - reference.twist).abs() < 1e-8);
+    assert!((eq.writhe - reference.writhe).abs() < 1e-6);
+    assert_eq!(eq.knot_determinant, reference.knot_determinant);
+    assert_eq!(eq.walled, reference.walled);
+    assert_eq!(eq.negative_eigenvalues, reference.negative_eigenvalues);
+}
+
+#[test]
+fn a_rod_of_natural_curvature_pi_rests_as_the_semicircle_of_its_clamps() {
+    // û1 = π bends the rod about d1 = e1 into the semicircle from the origin
+    // (tangent e3) to (0, −2/π, 0) (tangent −e3): clamped there, turned by π
+    // about e1, it rests at zero energy and zero reactions; the start is the
+    // cubic between the clamps, not the arc
+    let pi = std::f64::consts::PI;
+    let arc = |s: f64| Vector3::new(0.0, -(1.0 - (pi * s).cos()) / pi, (pi * s).sin() / pi);
+    let run = |n: usize| {
+        let text = format!(
+            "[model]\nsegments = {n}\nK2 = 2.0\nK3 = 1.5\nnatural_strains = [{pi}, 0.0, 0.0]\n\
+             [clamps]\nz_star = 0.0\ndelta = 0.0\nphi_over_2pi = 0.0\nend_shift = [0.0, {}]\n\
+             end_rotation = {{ axis_angle = [1.0, 0.0, 0.0, {pi}] }}\n\
+             [solver]\ngradient_tol = 1e-12\n[stability]\neigenvalues = 2\n",
+            -2.0 / pi
+        );
+        let scene = Scene::parse(&text).unwrap();
+        let eq = solve_scene(&scene, None).unwrap();
+        assert!(eq.converged && eq.stable, "N = {n}");
+        let reaction = Vector3::from(eq.n0).norm() + Vector3::from(eq.m0).norm();
+        let state = &eq.state;
+        let shape = (1..=n)
+            .map(|i| (state.nodes[i] - arc((i as f64 - 0.5) / n as f64)).norm())
+            .fold(0.0, f64::max);
+        (eq.energy, reaction, shape)
+    };
+    let runs: Vec<(f64, f64, f64)> = [25, 50, 100].into_iter().map(run).collect();
+    eprintln!("semicircle û1 = π, N = 25, 50, 100: (energy, |n(0)| + |m(0)|, shape) = {runs:?}");
+    for k in 0..2 {
+        let order = |a: f64, b: f64| (a / b).log2();
+        assert!(order(runs[k].0, runs[k + 1].0) > 1.8, "{runs:?}");
+        assert!(order(runs[k].1, runs[k + 1].1) > 1.8, "{runs:?}");
+        assert!(order(runs[k].2, runs[k + 1].2) > 1.8, "{runs:?}");
+    }
+    assert!(
+        runs[2].0 < 1e-4 && runs[2].1 < 1e-2 && runs[2].2 < 1e-4,
+        "{runs:?}"
+    );
 }

@@ -2,7 +2,7 @@
 //! the paper reports (clamp reactions, twist, walls, stability).
 
 use crate::analysis::class::GoodKnot;
-use crate::geometry::closure::{closure_knot, ray_closure, reach};
+use crate::geometry::closure::{closure_knot_along, ray_closure, reach};
 use crate::geometry::distance::{
     Approach, CurveTree, distance_to_ray, min_self_distance, strand_side,
 };
@@ -190,7 +190,8 @@ impl Conformation {
         previous: Option<&Equilibrium>,
     ) -> Conformation {
         let (points, arc) = state.centreline();
-        let e3 = Vector3::z();
+        let [down, up] = state.clamps.ray_directions();
+        let start = state.clamps.start_point();
         // the knot type and ray distances need the rays only to leave the
         // curve's neighbourhood
         let reach = reach(&points);
@@ -202,10 +203,15 @@ impl Conformation {
             distance_to_ray(&points, &arc, origin, &dir, reach, s_base, gap)
                 .map_or(f64::INFINITY, |d| d.0)
         };
-        let ray_distance = [ray(&Vector3::zeros(), -e3, 0.0), ray(&end, e3, 1.0)];
+        let ray_distance = [ray(&start, down, 0.0), ray(&end, up, 1.0)];
         let self_distance = self_approach.map_or(f64::INFINITY, |a| a.distance);
         let carried = previous.filter(|p| {
-            if p.state.nodes.len() != state.nodes.len() || p.knot_undefined {
+            if p.state.nodes.len() != state.nodes.len()
+                || p.knot_undefined
+                || !state.clamps.rays_parallel()
+                || p.state.clamps.start != state.clamps.start
+                || p.state.clamps.end.orientation != state.clamps.end.orientation
+            {
                 return false;
             }
             let moved = p.state.largest_node_distance(state)
@@ -251,13 +257,13 @@ impl Conformation {
                 if jump == 0.0 {
                     kept(p)
                 } else {
-                    closure_knot(&points).ok()
+                    closure_knot_along(&points, [down, up]).ok()
                 },
                 Measured::Passage,
             ),
             (None, None) => (
-                writhe_closed(&ray_closure(&points, -e3, e3, measure.ray_length)),
-                closure_knot(&points).ok(),
+                writhe_closed(&ray_closure(&points, down, up, measure.ray_length)),
+                closure_knot_along(&points, [down, up]).ok(),
                 Measured::Full,
             ),
         };
@@ -290,7 +296,12 @@ fn passage_jump(
     ray_distance: [f64; 2],
     gap: f64,
 ) -> Option<f64> {
-    if p.state.nodes.len() != state.nodes.len() || p.knot_undefined {
+    if p.state.nodes.len() != state.nodes.len()
+        || p.knot_undefined
+        || !state.clamps.rays_parallel()
+        || p.state.clamps.start != state.clamps.start
+        || p.state.clamps.end.orientation != state.clamps.end.orientation
+    {
         return None;
     }
     let moved = p.state.largest_node_distance(state)

@@ -18,7 +18,14 @@ pub fn ray_closure(
     let bottom = first + ray * bottom_dir.normalize();
     let top = last + ray * top_dir.normalize();
     // a side direction perpendicular to the mean ray axis
-    let axis = (top_dir.normalize() - bottom_dir.normalize()).normalize();
+    // (rays in one direction, as for clamps facing the same way, have no
+    // mean axis: take the rays' own)
+    let spread = top_dir.normalize() - bottom_dir.normalize();
+    let axis = if spread.norm() > 1e-9 {
+        spread.normalize()
+    } else {
+        top_dir.normalize()
+    };
     let trial = if axis.x.abs() < 0.9 {
         Vector3::x()
     } else {
@@ -54,5 +61,14 @@ pub fn closure_knot(
     points: &[Vector3<f64>],
 ) -> Result<crate::geometry::knot::KnotType, crate::geometry::knot::KnotError> {
     let e3 = Vector3::z();
-    crate::geometry::knot::knot_type(&ray_closure(points, -e3, e3, reach(points)))
+    closure_knot_along(points, [-e3, e3])
+}
+
+/// Knot type of the closure by rays along `rays[0]` from the first point and
+/// `rays[1]` from the last.
+pub fn closure_knot_along(
+    points: &[Vector3<f64>],
+    rays: [Vector3<f64>; 2],
+) -> Result<crate::geometry::knot::KnotType, crate::geometry::knot::KnotError> {
+    crate::geometry::knot::knot_type(&ray_closure(points, rays[0], rays[1], reach(points)))
 }

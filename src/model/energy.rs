@@ -759,13 +759,27 @@ impl RodEnergy {
     pub fn clamp_reactions(&self, state: &RodState) -> ClampReactions {
         let g = self.full_gradient(state);
         let force = -(g.nodes[0] + g.nodes[1]);
-        // a rotation ω moves clamp nodes by ω × x and turns the clamp's frame by
-        // ω; about e3 that is a change of θ_0 (for ω ⟂ e3 time-parallel transport
-        // of the clamp's reference director is the rigid rotation to first order)
-        let moment = -(state.nodes[0].cross(&g.nodes[0])
-            + state.nodes[1].cross(&g.nodes[1])
-            + g.theta[0] * Vector3::z());
-        ClampReactions { force, moment }
+        let c = &state.clamps;
+        if c.start.is_default() {
+            // a rotation ω moves clamp nodes by ω × x and turns the clamp's frame by
+            // ω; about e3 that is a change of θ_0 (for ω ⟂ e3 time-parallel transport
+            // of the clamp's reference director is the rigid rotation to first order)
+            let moment = -(state.nodes[0].cross(&g.nodes[0])
+                + state.nodes[1].cross(&g.nodes[1])
+                + g.theta[0] * Vector3::z());
+            return ClampReactions { force, moment };
+        }
+        // the same about the clamp's point, then in its material frame
+        let p = c.start_point();
+        let t = c.start_tangent();
+        let moment = -((state.nodes[0] - p).cross(&g.nodes[0])
+            + (state.nodes[1] - p).cross(&g.nodes[1])
+            + g.theta[0] * t);
+        let frame = c.start_frame().inverse();
+        ClampReactions {
+            force: frame * force,
+            moment: frame * moment,
+        }
     }
 
     /// Lumped mass of each free dof: the segment length for node coordinates,
@@ -780,32 +794,49 @@ impl RodEnergy {
 
 impl RodEnergy {
     /// Velocity of vertex i's 11 stencil variables (nodes i-1, i, i+1, angles
-    /// i-1, i) when the s = 1 clamp moves with `velocity`.
+    /// i-1, i) when the clamps move with `velocity`.
     fn clamp_local_velocity(&self, i: usize, velocity: &ClampVelocity) -> [f64; 11] {
         let n = self.model.segments;
         let mut vel = [0.0; 11];
         for (k, node) in [i - 1, i, i + 1].into_iter().enumerate() {
-            if node >= n {
-                vel[3 * k..3 * k + 3].copy_from_slice(velocity.end.as_slice());
+            let slot = match node {
+                0 => Some(0),
+                1 => Some(1),
+                _ if node == n => Some(2),
+                _ if node == n + 1 => Some(3),
+                _ => None,
+            };
+            if let Some(c) = slot {
+                vel[3 * k..3 * k + 3].copy_from_slice(velocity.nodes[c].as_slice());
             }
         }
+        if i == 1 {
+            vel[9] = velocity.theta[0];
+        }
         if i == n {
-            vel[10] = velocity.theta;
+            vel[10] = velocity.theta[1];
         }
         vel
     }
 
+    /// The vertices whose stencils touch a moving clamp: the last two, and the
+    /// first two when the s = 0 clamp moves.
+    fn clamp_vertices(&self, velocity: &ClampVelocity) -> impl Iterator<Item = usize> {
+        let n = self.model.segments;
+        let start = if velocity.moves_start() { 1..3 } else { 1..1 };
+        start.chain(n - 1..n + 1)
+    }
+
     /// ∂κ2_i/∂p for every constraint row (from `constraint_rows`) when the
-    /// s = 1 clamp moves with `velocity`: nonzero at the last two vertices.
+    /// clamps move with `velocity`: nonzero at the vertices next to a clamp.
     pub fn constraint_parameter_derivative(
         &self,
         rows: &[(f64, [f64; 11])],
         velocity: &ClampVelocity,
         out: &mut [f64],
     ) {
-        let n = self.model.segments;
         out.iter_mut().for_each(|v| *v = 0.0);
-        for i in [n - 1, n] {
+        for i in self.clamp_vertices(velocity) {
             let vel = self.clamp_local_velocity(i, velocity);
             out[i - 1] = rows[i - 1].1.iter().zip(&vel).map(|(g, v)| g * v).sum();
         }
@@ -824,9 +855,8 @@ impl RodEnergy {
     ) {
         let n = self.model.segments;
         out.iter_mut().for_each(|v| *v = 0.0);
-        let e = velocity.end;
         if self.terms.bending || self.terms.twisting {
-            for i in [n - 1, n] {
+            for i in self.clamp_vertices(velocity) {
                 let (_, _, hl) = self.vertex_local(state, i);
                 let vel = self.clamp_local_velocity(i, velocity);
                 for (a, d) in self.map.vertex_stencil(i).iter().enumerate() {
@@ -837,12 +867,19 @@ impl RodEnergy {
             }
         }
         if self.terms.stretching {
-            let j = n - 1;
-            let (_, _, hl) = self.edge_local(state, j);
-            let vel = [0.0, 0.0, 0.0, e.x, e.y, e.z];
-            for (a, d) in self.map.edge_stencil(j).iter().enumerate() {
-                if let Some(d) = d {
-                    out[*d] += (0..6).map(|b| hl[a * 6 + b] * vel[b]).sum::<f64>();
+            // the free edges next to the clamps: edge N−1 (its node N is the
+            // clamp's) and edge 1 (its node 1) when the s = 0 clamp moves
+            let [_, s1, e0, _] = velocity.nodes;
+            let first = velocity
+                .moves_start()
+                .then_some((1, [s1.x, s1.y, s1.z, 0.0, 0.0, 0.0]));
+            let last = Some((n - 1, [0.0, 0.0, 0.0, e0.x, e0.y, e0.z]));
+            for (j, vel) in first.into_iter().chain(last) {
+                let (_, _, hl) = self.edge_local(state, j);
+                for (a, d) in self.map.edge_stencil(j).iter().enumerate() {
+                    if let Some(d) = d {
+                        out[*d] += (0..6).map(|b| hl[a * 6 + b] * vel[b]).sum::<f64>();
+                    }
                 }
             }
         }

@@ -9,18 +9,38 @@
 
 use crate::geometry::walls::wall_clearance;
 use crate::model::frames::{self, V3};
-use nalgebra::Vector3;
+use nalgebra::{Rotation3, Unit, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// Velocity of the s = 1 clamp's dofs with respect to a loading parameter:
-/// both clamp nodes translate by `end`, the clamp angle turns by `theta`.
-#[derive(Clone, Copy, Debug)]
+/// Velocity of the clamps' dofs with respect to a loading parameter: the four
+/// clamp nodes (0, 1 at s = 0; N, N+1 at s = 1) and the two clamp angles
+/// (θ_0, θ_N).
+#[derive(Clone, Copy, Debug, Default)]
 pub struct ClampVelocity {
-    /// d(end point)/dp.
-    pub end: Vector3<f64>,
-    /// dφ/dp.
-    pub theta: f64,
+    /// d(node)/dp of nodes 0, 1, N, N+1.
+    pub nodes: [Vector3<f64>; 4],
+    /// dθ_0/dp and dθ_N/dp.
+    pub theta: [f64; 2],
+}
+
+impl ClampVelocity {
+    /// Only the s = 1 clamp moves: both its nodes translate by `end`, its angle
+    /// turns by `theta`.
+    pub fn end(end: Vector3<f64>, theta: f64) -> Self {
+        let z = Vector3::zeros();
+        ClampVelocity {
+            nodes: [z, z, end, end],
+            theta: [0.0, theta],
+        }
+    }
+
+    /// Whether the s = 0 clamp moves (its stencils then enter ∂p∇E).
+    pub fn moves_start(&self) -> bool {
+        self.nodes[0] != Vector3::zeros()
+            || self.nodes[1] != Vector3::zeros()
+            || self.theta[0] != 0.0
+    }
 }
 
 /// Material and discretisation parameters of a rod.
@@ -124,24 +144,143 @@ impl RodModel {
     }
 }
 
-/// The clamp at s = 1 (the clamp at s = 0 is the identity frame at the origin).
+/// Orientation of a clamp before its turn about its own tangent: a fixed
+/// rotation, then a tilt of the tangent. The clamp's tangent is `matrix()·e3`
+/// and its reference director `matrix()·e1`; the identity is the paper's clamp
+/// along e3.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(default)]
+pub struct Orientation {
+    /// Rotation taking (e1, e2, e3) to the clamp's frame before the tilt.
+    pub rotation: UnitQuaternion<f64>,
+    /// Tilt angle (radians): a rotation by this angle about the lab axis
+    /// (−sin ψ, cos ψ, 0), applied after `rotation`; it takes e3 to
+    /// (sin t cos ψ, sin t sin ψ, cos t).
+    pub tilt: f64,
+    /// Azimuth ψ of the tilt's direction about e3 (radians).
+    pub tilt_azimuth: f64,
+}
+
+impl Default for Orientation {
+    fn default() -> Self {
+        Orientation {
+            rotation: UnitQuaternion::identity(),
+            tilt: 0.0,
+            tilt_azimuth: 0.0,
+        }
+    }
+}
+
+impl Orientation {
+    /// The paper's orientation (tangent e3, reference e1).
+    pub fn is_identity(&self) -> bool {
+        *self == Orientation::default()
+    }
+
+    /// Axis of the tilt (lab frame).
+    fn tilt_axis(&self) -> Vector3<f64> {
+        Vector3::new(-self.tilt_azimuth.sin(), self.tilt_azimuth.cos(), 0.0)
+    }
+
+    /// The rotation (tilt after `rotation`).
+    pub fn matrix(&self) -> Rotation3<f64> {
+        Rotation3::from_axis_angle(&Unit::new_unchecked(self.tilt_axis()), self.tilt)
+            * self.rotation.to_rotation_matrix()
+    }
+
+    /// Unit tangent of the clamp (exactly e3 for the identity).
+    pub fn tangent(&self) -> Vector3<f64> {
+        if self.is_identity() {
+            return Vector3::z();
+        }
+        self.matrix() * Vector3::z()
+    }
+
+    /// Reference director of the clamp (exactly e1 for the identity); the
+    /// material director d1 is it turned about the tangent by the clamp's turn.
+    pub fn reference(&self) -> Vector3<f64> {
+        if self.is_identity() {
+            return Vector3::x();
+        }
+        self.matrix() * Vector3::x()
+    }
+
+    /// Angular velocity (lab frame) of the frame per unit change of the tilt
+    /// and of its azimuth.
+    fn tilt_rates(&self) -> [Vector3<f64>; 2] {
+        let tilted = Rotation3::from_axis_angle(&Unit::new_unchecked(self.tilt_axis()), self.tilt);
+        // R(ψ) = Rz(ψ) R(0) Rz(−ψ): dR/dψ Rᵀ = ê3 − (R e3)^
+        [self.tilt_axis(), Vector3::z() - tilted * Vector3::z()]
+    }
+}
+
+/// The s = 0 clamp: a rigid frame (the paper's is the identity at the origin).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(default)]
+pub struct StartClamp {
+    /// Position of the rod's end r(0).
+    pub position: Vector3<f64>,
+    /// Orientation before the turn.
+    pub orientation: Orientation,
+    /// Turn of the material frame about the tangent (radians, continuous).
+    pub turn: f64,
+}
+
+impl StartClamp {
+    /// The paper's s = 0 clamp.
+    pub fn is_default(&self) -> bool {
+        *self == StartClamp::default()
+    }
+}
+
+/// General placement of the s = 1 clamp beyond the paper's (z*, δ, φ): a shift
+/// of its point in (x, y) and its orientation before the turn φ.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(default)]
+pub struct EndPlacement {
+    /// Added to (x*, y*).
+    pub shift: [f64; 2],
+    /// Orientation before the turn φ.
+    pub orientation: Orientation,
+}
+
+impl EndPlacement {
+    /// The paper's placement (no shift, clamp along e3).
+    pub fn is_default(&self) -> bool {
+        *self == EndPlacement::default()
+    }
+}
+
+/// The two clamps. The s = 1 clamp sits at (x − δ cos φ/2, y − δ sin φ/2, z*)
+/// (eq. 2.13 when the shift (x, y) is zero), oriented by `end.orientation` and
+/// turned by φ about its tangent; the s = 0 clamp is `start` (by default the
+/// identity frame at the origin). With the defaults this is the paper's family.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Clamps {
-    /// End displacement z*.
+    /// End displacement z* (height of the s = 1 clamp's point).
     pub z_star: f64,
     /// End shift δ along the flip axis (eq. 2.13).
     pub delta: f64,
-    /// End rotation φ in radians, continuous (turns are kept).
+    /// End rotation φ in radians, continuous (turns are kept): the s = 1
+    /// clamp's turn about its own tangent.
     pub phi: f64,
+    /// Shift and orientation of the s = 1 clamp (default: the paper's).
+    #[serde(default, skip_serializing_if = "EndPlacement::is_default")]
+    pub end: EndPlacement,
+    /// The s = 0 clamp (default: the paper's).
+    #[serde(default, skip_serializing_if = "StartClamp::is_default")]
+    pub start: StartClamp,
 }
 
 impl Clamps {
-    /// From (z*, δ, φ/2π).
+    /// From (z*, δ, φ/2π): the paper's family.
     pub fn new(z_star: f64, delta: f64, phi_over_2pi: f64) -> Self {
         Clamps {
             z_star,
             delta,
             phi: 2.0 * PI * phi_over_2pi,
+            end: EndPlacement::default(),
+            start: StartClamp::default(),
         }
     }
 
@@ -150,14 +289,196 @@ impl Clamps {
         self.phi / (2.0 * PI)
     }
 
-    /// End point (x*, y*, z*) = (-δ cos φ/2, -δ sin φ/2, z*) (eq. 2.13).
+    /// Whether both clamps are the paper's (e3-aligned, s = 0 at the origin):
+    /// the walls, the rays along ∓e3 and Lk − φ/2π ∈ ℤ hold as in the paper.
+    pub fn is_paper(&self) -> bool {
+        self.end.is_default() && self.start.is_default()
+    }
+
+    /// End point r(1) = (x − δ cos φ/2, y − δ sin φ/2, z*) (eq. 2.13 with no shift).
     pub fn end_point(&self) -> Vector3<f64> {
-        Vector3::new(
+        let p = Vector3::new(
             -self.delta * (self.phi / 2.0).cos(),
             -self.delta * (self.phi / 2.0).sin(),
             self.z_star,
-        )
+        );
+        let [x, y] = self.end.shift;
+        if x == 0.0 && y == 0.0 {
+            return p;
+        }
+        p + Vector3::new(x, y, 0.0)
     }
+
+    /// The clamps a fraction `f` of the way to `to`, every scalar linearly (z*,
+    /// δ and φ in the same floating-point steps as the paper's loading paths).
+    pub fn lerp(&self, to: &Clamps, f: f64) -> Clamps {
+        let mut c = Clamps {
+            z_star: self.z_star + f * (to.z_star - self.z_star),
+            delta: self.delta + f * (to.delta - self.delta),
+            phi: self.phi + f * (to.phi - self.phi),
+            ..*self
+        };
+        for p in &Parameter::ALL[3..] {
+            let (a, b) = (p.value(self), p.value(to));
+            if a != b {
+                c = p.with(&c, a + f * (b - a));
+            }
+        }
+        let turn = |a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>| {
+            if a == b { *a } else { a.slerp(b, f) }
+        };
+        c.end.orientation.rotation =
+            turn(&self.end.orientation.rotation, &to.end.orientation.rotation);
+        c.start.orientation.rotation = turn(
+            &self.start.orientation.rotation,
+            &to.start.orientation.rotation,
+        );
+        c
+    }
+
+    /// Halfway between two clamps (z*, δ, φ as the paper's bisections take it).
+    pub fn midpoint(&self, to: &Clamps) -> Clamps {
+        Clamps {
+            z_star: 0.5 * (self.z_star + to.z_star),
+            delta: 0.5 * (self.delta + to.delta),
+            phi: 0.5 * (self.phi + to.phi),
+            ..self.lerp(to, 0.5)
+        }
+    }
+
+    /// Largest change of any scalar between two clamps (φ and turns in turns).
+    pub fn gap(&self, to: &Clamps) -> f64 {
+        let mut g = Parameter::ALL
+            .iter()
+            .map(|p| (p.value(self) - p.value(to)).abs())
+            .fold(0.0, f64::max);
+        for (a, b) in [
+            (self.end.orientation.rotation, to.end.orientation.rotation),
+            (
+                self.start.orientation.rotation,
+                to.start.orientation.rotation,
+            ),
+        ] {
+            if a != b {
+                g = g.max(a.angle_to(&b));
+            }
+        }
+        g
+    }
+
+    /// The cubic from r(0) along t(0) to r(1) along t(1) (tangents scaled by
+    /// the distance of the clamps): a start shape for general clamps, straight
+    /// when both tangents lie along the chord.
+    pub fn hermite(&self, s: f64) -> Vector3<f64> {
+        let (p0, p1) = (self.start_point(), self.end_point());
+        let l = (p1 - p0).norm().max(1e-3);
+        let (s2, s3) = (s * s, s * s * s);
+        p0 * (2.0 * s3 - 3.0 * s2 + 1.0)
+            + self.start_tangent() * (l * (s3 - 2.0 * s2 + s))
+            + p1 * (-2.0 * s3 + 3.0 * s2)
+            + self.end_tangent() * (l * (s3 - s2))
+    }
+
+    /// d1 blended linearly from the s = 0 clamp's to the s = 1 clamp's (the
+    /// start shape's material frame; only its projection ⟂ the tangent counts).
+    pub fn blended_d1(&self, s: f64) -> Vector3<f64> {
+        let d0 = self.start_frame() * Vector3::x();
+        let d1 = self.end_frame() * Vector3::x();
+        d0 * (1.0 - s) + d1 * s
+    }
+
+    /// Height of the s = 1 clamp's point above the s = 0 clamp's along the
+    /// s = 0 tangent: the upper wall (z* for the paper's clamps).
+    pub fn top_wall(&self) -> f64 {
+        if self.start.is_default() {
+            return self.z_star;
+        }
+        (self.end_point() - self.start_point()).dot(&self.start_tangent())
+    }
+
+    /// Whether the clamps' rays are parallel (−e3 from r(0), +e3 from r(1)),
+    /// so that the ray closure's link less φ/2π is an integer (Lk = Tw + Wr
+    /// = n + φ/2π) and can be carried along a branch.
+    pub fn rays_parallel(&self) -> bool {
+        self.start.is_default() && self.end.orientation.is_identity()
+    }
+
+    /// Directions of the rays that close the rod: −t(0) from r(0), +t(1) from r(1).
+    pub fn ray_directions(&self) -> [Vector3<f64>; 2] {
+        [-self.start_tangent(), self.end_tangent()]
+    }
+
+    /// Start point r(0).
+    pub fn start_point(&self) -> Vector3<f64> {
+        self.start.position
+    }
+
+    /// Unit tangent of the s = 1 clamp.
+    pub fn end_tangent(&self) -> Vector3<f64> {
+        self.end.orientation.tangent()
+    }
+
+    /// Unit tangent of the s = 0 clamp.
+    pub fn start_tangent(&self) -> Vector3<f64> {
+        self.start.orientation.tangent()
+    }
+
+    /// Material frame (d1, d2, d3) of the s = 0 clamp, columns of a rotation.
+    pub fn start_frame(&self) -> Rotation3<f64> {
+        self.start.orientation.matrix()
+            * Rotation3::from_axis_angle(&Vector3::z_axis(), self.start.turn)
+    }
+
+    /// Material frame (d1, d2, d3) of the s = 1 clamp.
+    pub fn end_frame(&self) -> Rotation3<f64> {
+        self.end.orientation.matrix() * Rotation3::from_axis_angle(&Vector3::z_axis(), self.phi)
+    }
+
+    /// Distance between the clamp points: at most the rod's length 1.
+    pub fn span(&self) -> f64 {
+        (self.end_point() - self.start_point()).norm()
+    }
+
+    /// How the clamp dofs of `state` (at these clamps) move to reach `target`,
+    /// as a velocity over a unit step: ∂_c∇E is linear in it.
+    pub fn velocity_to(&self, target: &Clamps, state: &RodState) -> ClampVelocity {
+        let n = state.segments();
+        let mut v =
+            ClampVelocity::end(target.end_point() - self.end_point(), target.phi - self.phi);
+        if target.end.orientation != self.end.orientation {
+            let (a, b) = clamp_edge(target.end_point(), target.end_tangent(), n);
+            v.nodes[2] = a - state.nodes[n];
+            v.nodes[3] = b - state.nodes[n + 1];
+            v.theta[1] += rigid_turn(&self.end.orientation, &target.end.orientation);
+        }
+        if target.start != self.start {
+            let (a, b) = clamp_edge(target.start_point(), target.start_tangent(), n);
+            v.nodes[0] = a - state.nodes[0];
+            v.nodes[1] = b - state.nodes[1];
+            v.theta[0] = target.start.turn - self.start.turn
+                + rigid_turn(&self.start.orientation, &target.start.orientation);
+        }
+        v
+    }
+}
+
+/// Nodes of a clamp edge of length h = 1/n centred on `point` along `tangent`.
+fn clamp_edge(
+    point: Vector3<f64>,
+    tangent: Vector3<f64>,
+    n: usize,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let h = 1.0 / n as f64;
+    (point - 0.5 * h * tangent, point + 0.5 * h * tangent)
+}
+
+/// Change of the material angle of a clamp edge when its orientation turns
+/// from `a` to `b` and its reference director is parallel transported: the
+/// angle, about the new tangent, from the transported old reference to the
+/// new one.
+fn rigid_turn(a: &Orientation, b: &Orientation) -> f64 {
+    let moved = transport(&a.reference(), &a.tangent(), &b.tangent());
+    frames::signed_angle(v3(&moved), v3(&b.reference()), v3(&b.tangent()))
 }
 
 /// Index map between the rod's nodes/angles and the free degrees of freedom.
@@ -298,14 +619,20 @@ impl RodState {
         let h = 1.0 / n as f64;
         let e3 = Vector3::z();
         let end = clamps.end_point();
+        let t_end = clamps.end_tangent();
         let mut nodes: Vec<Vector3<f64>> = (0..n + 2).map(|i| r((i as f64 - 0.5) * h)).collect();
-        nodes[0] = -0.5 * h * e3;
-        nodes[1] = 0.5 * h * e3;
-        nodes[n] = end - 0.5 * h * e3;
-        nodes[n + 1] = end + 0.5 * h * e3;
+        if clamps.start.is_default() {
+            nodes[0] = -0.5 * h * e3;
+            nodes[1] = 0.5 * h * e3;
+        } else {
+            (nodes[0], nodes[1]) = clamp_edge(clamps.start_point(), clamps.start_tangent(), n);
+        }
+        nodes[n] = end - 0.5 * h * t_end;
+        nodes[n + 1] = end + 0.5 * h * t_end;
         // space-parallel reference frames from the s = 0 clamp; zero reference
         // twist in between
         let mut reference = vec![Vector3::x(); n + 1];
+        reference[0] = clamps.start.orientation.reference();
         for j in 1..n {
             let a = transport(
                 &reference[j - 1],
@@ -316,9 +643,10 @@ impl RodState {
             let t = tangent(&nodes, j);
             reference[j] = (a - a.dot(&t) * t).normalize();
         }
-        reference[n] = Vector3::x();
+        reference[n] = clamps.end.orientation.reference();
         let mut reference_twist = vec![0.0; n + 1];
         let mut theta = vec![0.0; n + 1];
+        theta[0] = clamps.start.turn;
         for j in 1..n {
             let t = tangent(&nodes, j);
             let a1 = reference[j];
@@ -344,6 +672,14 @@ impl RodState {
     /// Straight rod from (0,0,0) to the clamp end point, with the material frame
     /// turning uniformly by φ (a straight twisted rod when δ = 0).
     pub fn straight(n: usize, clamps: Clamps) -> RodState {
+        if !clamps.is_paper() {
+            return RodState::from_curve(
+                n,
+                clamps,
+                |s| clamps.hermite(s),
+                |s| clamps.blended_d1(s),
+            );
+        }
         let end = clamps.end_point();
         let phi = clamps.phi;
         RodState::from_curve(
@@ -376,10 +712,7 @@ impl RodState {
         next.nodes.copy_from_slice(&self.nodes);
         next.theta.copy_from_slice(&self.theta);
         next.multipliers.clone_from(&self.multipliers);
-        let shift = clamps.end_point() - self.clamps.end_point();
-        next.nodes[n] += shift;
-        next.nodes[n + 1] += shift;
-        next.theta[n] = clamps.phi;
+        next.move_clamp_nodes(&self.clamps);
         for i in 2..n {
             let d = map.node(i).unwrap();
             next.nodes[i] += Vector3::new(dq[d], dq[d + 1], dq[d + 2]);
@@ -388,6 +721,58 @@ impl RodState {
             next.theta[j] += dq[map.theta(j).unwrap()];
         }
         next.update_frames_from(self);
+        next.set_clamp_angles(self);
+    }
+
+    /// Move the four clamp nodes from their place at `old` clamps to this
+    /// state's clamps: a translation when the orientation is unchanged (so that
+    /// the paper's clamps move exactly as before), else placed afresh.
+    fn move_clamp_nodes(&mut self, old: &Clamps) {
+        let n = self.segments();
+        let c = self.clamps;
+        if c.end.orientation == old.end.orientation {
+            let shift = c.end_point() - old.end_point();
+            self.nodes[n] += shift;
+            self.nodes[n + 1] += shift;
+        } else {
+            (self.nodes[n], self.nodes[n + 1]) = clamp_edge(c.end_point(), c.end_tangent(), n);
+        }
+        if c.start.position != old.start.position || c.start.orientation != old.start.orientation {
+            (self.nodes[0], self.nodes[1]) = clamp_edge(c.start_point(), c.start_tangent(), n);
+        }
+    }
+
+    /// Material angles of the clamp edges after the reference frames were
+    /// transported from `old`: the clamp's turn plus the angle from the
+    /// transported reference to the clamp's reference director, continued from
+    /// its value at `old` (zero for the paper's clamps, so θ_N = φ exactly).
+    fn set_clamp_angles(&mut self, old: &RodState) {
+        let n = self.segments();
+        let c = self.clamps;
+        let o = old.clamps;
+        let offset = |state: &RodState, j: usize, orientation: &Orientation, previous: f64| {
+            let t = tangent(&state.nodes, j);
+            let raw = frames::signed_angle(
+                v3(&state.reference[j]),
+                v3(&orientation.reference()),
+                v3(&t),
+            );
+            previous + wrap(raw - previous)
+        };
+        let before = old.theta[n] - o.phi;
+        self.theta[n] = c.phi
+            + if c.end.orientation == o.end.orientation {
+                before
+            } else {
+                offset(self, n, &c.end.orientation, before)
+            };
+        let before = old.theta[0] - o.start.turn;
+        self.theta[0] = c.start.turn
+            + if c.start.orientation == o.start.orientation {
+                before
+            } else {
+                offset(self, 0, &c.start.orientation, before)
+            };
     }
 
     /// Time-parallel transport the reference directors from `old` (same N) to
@@ -396,6 +781,11 @@ impl RodState {
         let n = self.segments();
         let mut t_prev = tangent(&self.nodes, 0);
         self.reference[0] = old.reference[0];
+        if self.nodes[..2] != old.nodes[..2] {
+            // the s = 0 clamp moved: its reference director is transported too
+            let a = transport(&old.reference[0], &tangent(&old.nodes, 0), &t_prev);
+            self.reference[0] = (a - a.dot(&t_prev) * t_prev).normalize();
+        }
         for j in 1..=n {
             let t_old = tangent(&old.nodes, j);
             let t = tangent(&self.nodes, j);
@@ -441,42 +831,56 @@ impl RodState {
             .fold(0.0, f64::max)
     }
 
-    /// Clearance of the interior extrema of z from the walls z = 0 and z = z*
-    /// (negative: outside; see [`wall_clearance`]).
-    pub fn wall_clearance(&self) -> f64 {
-        // the interior nodes 1..=N are the centreline without its clamp ends
+    /// Heights of the interior nodes 1..=N (s in (0,1)) along the s = 0
+    /// clamp's tangent, above its point: z for the paper's clamps.
+    fn heights(&self) -> Vec<f64> {
         let n = self.segments();
-        let heights: Vec<f64> = self.nodes[1..=n].iter().map(|p| p.z).collect();
-        wall_clearance(&heights, self.clamps.z_star)
+        let interior = &self.nodes[1..=n];
+        if self.clamps.start.is_default() {
+            return interior.iter().map(|p| p.z).collect();
+        }
+        let (r0, t0) = (self.clamps.start_point(), self.clamps.start_tangent());
+        interior.iter().map(|p| (p - r0).dot(&t0)).collect()
     }
 
-    /// Interior node heights: (min z, max z) over nodes 1..=N (s in (0,1)).
+    /// Clearance of the interior extrema of the height from the walls at 0 and
+    /// at the s = 1 clamp's height (z = 0 and z = z* for the paper's clamps;
+    /// negative: outside; see [`wall_clearance`]).
+    pub fn wall_clearance(&self) -> f64 {
+        wall_clearance(&self.heights(), self.clamps.top_wall())
+    }
+
+    /// Interior node heights: (min, max) over nodes 1..=N (s in (0,1)).
     pub fn z_range(&self) -> (f64, f64) {
-        let n = self.segments();
-        self.nodes[1..=n]
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                (lo.min(x[2]), hi.max(x[2]))
+        self.heights()
+            .into_iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| {
+                (lo.min(z), hi.max(z))
             })
     }
 
-    /// Walled: every interior node strictly between the planes z = 0 and z = z*.
+    /// Walled: every interior node strictly between the walls.
     pub fn walled(&self) -> bool {
         let (lo, hi) = self.z_range();
-        lo > 0.0 && hi < self.clamps.z_star
+        lo > 0.0 && hi < self.clamps.top_wall()
     }
 
     /// Move the s = 1 clamp to new parameters: the two clamp nodes translate, the
     /// clamp angle becomes φ; interior dofs are kept.
     pub fn set_clamps(&mut self, clamps: Clamps) {
         let n = self.segments();
-        let shift = clamps.end_point() - self.clamps.end_point();
-        self.nodes[n] += shift;
-        self.nodes[n + 1] += shift;
-        let old = self.clone();
-        self.theta[n] = clamps.phi;
+        let before = self.clamps;
+        let mut old = self.clone();
         self.clamps = clamps;
+        self.move_clamp_nodes(&before);
+        if clamps.end.orientation == before.end.orientation {
+            // a translated clamp: the frames are transported from the moved
+            // nodes, i.e. only the clamp edge's neighbours feel the move
+            old.nodes[n] = self.nodes[n];
+            old.nodes[n + 1] = self.nodes[n + 1];
+        }
         self.update_frames_from(&old);
+        self.set_clamp_angles(&old);
     }
 }
 
@@ -504,7 +908,7 @@ impl RodState {
         let h = 1.0 / n as f64;
         let mut points = Vec::with_capacity(n + 2);
         let mut arc = Vec::with_capacity(n + 2);
-        points.push(Vector3::zeros());
+        points.push(self.clamps.start_point());
         arc.push(0.0);
         for i in 1..=n {
             points.push(self.nodes[i]);
@@ -516,26 +920,75 @@ impl RodState {
     }
 }
 
-/// A loading parameter of the s = 1 clamp.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+/// A scalar of the clamps that a branch, a loading path, a sweep or a map can
+/// vary. Angles of turn are measured in turns (φ/2π), tilts in radians.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[serde(rename_all = "snake_case")]
 pub enum Parameter {
-    /// End displacement z*.
+    /// End displacement z* (height of the s = 1 clamp).
     ZStar,
     /// End shift δ.
     Delta,
     /// End rotation, measured as φ/2π.
     #[serde(alias = "phi_over_2pi")]
     Phi,
+    /// x-shift of the s = 1 clamp's point (added to the paper's x*).
+    EndX,
+    /// y-shift of the s = 1 clamp's point.
+    EndY,
+    /// Tilt of the s = 1 clamp's tangent (radians).
+    EndTilt,
+    /// Azimuth of that tilt about e3 (radians).
+    EndTiltAzimuth,
+    /// x of the s = 0 clamp's point.
+    StartX,
+    /// y of the s = 0 clamp's point.
+    StartY,
+    /// z of the s = 0 clamp's point.
+    StartZ,
+    /// Tilt of the s = 0 clamp's tangent (radians).
+    StartTilt,
+    /// Azimuth of that tilt about e3 (radians).
+    StartTiltAzimuth,
+    /// Turn of the s = 0 clamp about its tangent, in turns (/2π).
+    #[serde(alias = "start_turn_over_2pi")]
+    StartTurn,
 }
 
 impl Parameter {
+    /// Every parameter, in the order of the scene format's documentation.
+    pub const ALL: [Parameter; 13] = [
+        Parameter::ZStar,
+        Parameter::Delta,
+        Parameter::Phi,
+        Parameter::EndX,
+        Parameter::EndY,
+        Parameter::EndTilt,
+        Parameter::EndTiltAzimuth,
+        Parameter::StartX,
+        Parameter::StartY,
+        Parameter::StartZ,
+        Parameter::StartTilt,
+        Parameter::StartTiltAzimuth,
+        Parameter::StartTurn,
+    ];
+
     /// Its value for `clamps` (φ as φ/2π).
     pub fn value(&self, c: &Clamps) -> f64 {
         match self {
             Parameter::ZStar => c.z_star,
             Parameter::Delta => c.delta,
             Parameter::Phi => c.phi_over_2pi(),
+            Parameter::EndX => c.end.shift[0],
+            Parameter::EndY => c.end.shift[1],
+            Parameter::EndTilt => c.end.orientation.tilt,
+            Parameter::EndTiltAzimuth => c.end.orientation.tilt_azimuth,
+            Parameter::StartX => c.start.position.x,
+            Parameter::StartY => c.start.position.y,
+            Parameter::StartZ => c.start.position.z,
+            Parameter::StartTilt => c.start.orientation.tilt,
+            Parameter::StartTiltAzimuth => c.start.orientation.tilt_azimuth,
+            Parameter::StartTurn => c.start.turn / (2.0 * PI),
         }
     }
 
@@ -546,30 +999,110 @@ impl Parameter {
             Parameter::ZStar => c.z_star = v,
             Parameter::Delta => c.delta = v,
             Parameter::Phi => c.phi = 2.0 * PI * v,
+            Parameter::EndX => c.end.shift[0] = v,
+            Parameter::EndY => c.end.shift[1] = v,
+            Parameter::EndTilt => c.end.orientation.tilt = v,
+            Parameter::EndTiltAzimuth => c.end.orientation.tilt_azimuth = v,
+            Parameter::StartX => c.start.position.x = v,
+            Parameter::StartY => c.start.position.y = v,
+            Parameter::StartZ => c.start.position.z = v,
+            Parameter::StartTilt => c.start.orientation.tilt = v,
+            Parameter::StartTiltAzimuth => c.start.orientation.tilt_azimuth = v,
+            Parameter::StartTurn => c.start.turn = 2.0 * PI * v,
         }
         c
     }
 
-    /// How the clamp's dofs move with the parameter.
-    pub fn velocity(&self, c: &Clamps) -> ClampVelocity {
+    /// Whether it moves the s = 0 clamp.
+    pub fn moves_start(&self) -> bool {
+        matches!(
+            self,
+            Parameter::StartX
+                | Parameter::StartY
+                | Parameter::StartZ
+                | Parameter::StartTilt
+                | Parameter::StartTiltAzimuth
+                | Parameter::StartTurn
+        )
+    }
+
+    /// How the clamp dofs of `state` move with the parameter (exact: the
+    /// derivative of the clamp nodes and angles at the state's clamps).
+    pub fn velocity(&self, state: &RodState) -> ClampVelocity {
+        let c = &state.clamps;
+        let n = state.segments();
         let half = c.phi / 2.0;
-        let (end, theta) = match self {
-            Parameter::ZStar => (Vector3::z(), 0.0),
-            Parameter::Delta => (Vector3::new(-half.cos(), -half.sin(), 0.0), 0.0),
-            Parameter::Phi => (
+        let z = Vector3::zeros();
+        // a rigid rotation ω of a clamp about its point p moves its nodes by
+        // ω × (x − p) and, as its reference director is parallel transported,
+        // turns its material angle by ω·t
+        let rotate = |omega: Vector3<f64>, start: bool| {
+            let (p, a, b) = if start {
+                (c.start_point(), state.nodes[0], state.nodes[1])
+            } else {
+                (c.end_point(), state.nodes[n], state.nodes[n + 1])
+            };
+            let t = (b - a).normalize();
+            (omega.cross(&(a - p)), omega.cross(&(b - p)), omega.dot(&t))
+        };
+        match self {
+            Parameter::ZStar => ClampVelocity::end(Vector3::z(), 0.0),
+            Parameter::Delta => {
+                ClampVelocity::end(Vector3::new(-half.cos(), -half.sin(), 0.0), 0.0)
+            }
+            Parameter::Phi => ClampVelocity::end(
                 Vector3::new(c.delta * PI * half.sin(), -c.delta * PI * half.cos(), 0.0),
                 2.0 * PI,
             ),
-        };
-        ClampVelocity { end, theta }
+            Parameter::EndX => ClampVelocity::end(Vector3::x(), 0.0),
+            Parameter::EndY => ClampVelocity::end(Vector3::y(), 0.0),
+            Parameter::EndTilt | Parameter::EndTiltAzimuth => {
+                let k = usize::from(*self == Parameter::EndTiltAzimuth);
+                let (a, b, th) = rotate(c.end.orientation.tilt_rates()[k], false);
+                ClampVelocity {
+                    nodes: [z, z, a, b],
+                    theta: [0.0, th],
+                }
+            }
+            Parameter::StartX | Parameter::StartY | Parameter::StartZ => {
+                let mut e = Vector3::zeros();
+                e[*self as usize - Parameter::StartX as usize] = 1.0;
+                ClampVelocity {
+                    nodes: [e, e, z, z],
+                    theta: [0.0, 0.0],
+                }
+            }
+            Parameter::StartTilt | Parameter::StartTiltAzimuth => {
+                let k = usize::from(*self == Parameter::StartTiltAzimuth);
+                let (a, b, th) = rotate(c.start.orientation.tilt_rates()[k], true);
+                ClampVelocity {
+                    nodes: [a, b, z, z],
+                    theta: [th, 0.0],
+                }
+            }
+            Parameter::StartTurn => ClampVelocity {
+                nodes: [z; 4],
+                theta: [2.0 * PI, 0.0],
+            },
+        }
     }
 
-    /// Name as in summaries.
+    /// Name as in scenes and summaries.
     pub fn name(&self) -> &'static str {
         match self {
             Parameter::ZStar => "z_star",
             Parameter::Delta => "delta",
             Parameter::Phi => "phi_over_2pi",
+            Parameter::EndX => "end_x",
+            Parameter::EndY => "end_y",
+            Parameter::EndTilt => "end_tilt",
+            Parameter::EndTiltAzimuth => "end_tilt_azimuth",
+            Parameter::StartX => "start_x",
+            Parameter::StartY => "start_y",
+            Parameter::StartZ => "start_z",
+            Parameter::StartTilt => "start_tilt",
+            Parameter::StartTiltAzimuth => "start_tilt_azimuth",
+            Parameter::StartTurn => "start_turn_over_2pi",
         }
     }
 }

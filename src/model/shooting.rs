@@ -82,11 +82,42 @@ impl ShootingSolution {
         natural: Vector3<f64>,
         steps: usize,
     ) -> Self {
+        Self::integrate_from(
+            &Clamps::new(0.0, 0.0, 0.0),
+            n0,
+            m0,
+            [k2, k3],
+            [weight, natural],
+            steps,
+        )
+    }
+
+    /// As `integrate_loaded`, from the s = 0 clamp of `clamps` (r(0) at its
+    /// point, the directors its material frame; n(0), m(0) in that frame).
+    pub fn integrate_from(
+        clamps: &Clamps,
+        n0: Vector3<f64>,
+        m0: Vector3<f64>,
+        [k2, k3]: [f64; 2],
+        [weight, natural]: [Vector3<f64>; 2],
+        steps: usize,
+    ) -> Self {
         let f = |y: &OdeState| rhs_loaded(y, k2, k3, &weight, &natural);
         let mut y = OdeState::zeros();
-        y[3] = 1.0;
-        y[7] = 1.0;
-        y[11] = 1.0;
+        if clamps.start.is_default() {
+            y[3] = 1.0;
+            y[7] = 1.0;
+            y[11] = 1.0;
+        } else {
+            let frame = clamps.start_frame();
+            let r = clamps.start_point();
+            for c in 0..3 {
+                y[c] = r[c];
+                for k in 0..3 {
+                    y[3 * (k + 1) + c] = frame[(c, k)];
+                }
+            }
+        }
         for c in 0..3 {
             y[12 + c] = n0[c];
             y[15 + c] = m0[c];
@@ -153,8 +184,15 @@ impl ShootingSolution {
     pub fn boundary_residual(&self, clamps: &Clamps) -> Vector6<f64> {
         let y = self.end();
         let r = part(y, 0) - clamps.end_point();
-        let d1 = part(y, 1);
-        let d3 = part(y, 3);
+        let mut d1 = part(y, 1);
+        let mut d3 = part(y, 3);
+        let o = &clamps.end.orientation;
+        if !o.is_identity() {
+            // components in the clamp's frame before its turn φ
+            let back = o.matrix().inverse();
+            d1 = back * d1;
+            d3 = back * d3;
+        }
         Vector6::new(
             r[0],
             r[1],
@@ -201,13 +239,12 @@ pub fn refine_shooting_loaded(
 ) -> Option<(Vector3<f64>, Vector3<f64>)> {
     let mut p = Vector6::new(n0[0], n0[1], n0[2], m0[0], m0[1], m0[2]);
     let res = |p: &Vector6<f64>| {
-        ShootingSolution::integrate_loaded(
+        ShootingSolution::integrate_from(
+            clamps,
             p.fixed_rows::<3>(0).into(),
             p.fixed_rows::<3>(3).into(),
-            k2,
-            k3,
-            weight,
-            natural,
+            [k2, k3],
+            [weight, natural],
             steps,
         )
         .boundary_residual(clamps)

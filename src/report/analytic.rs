@@ -82,9 +82,8 @@ pub fn greenhill_twisting_moment(n: usize, k3: f64, stretching_stiffness: f64) -
         Ok(straight_equilibrium(
             &mut newton,
             Clamps {
-                z_star: 1.0,
-                delta: 0.0,
                 phi,
+                ..Clamps::new(1.0, 0.0, 0.0)
             },
         )?
         .1 > 0)

@@ -15,7 +15,7 @@ pub use map::{MapSpec, SliceSpec};
 use crate::analysis::class::{Clearance, GoodKnot};
 use crate::analysis::equilibrium::Measure;
 use crate::model::contact::ContactModel;
-use crate::model::rod::{Clamps, Law, Parameter, RodModel, RodState};
+use crate::model::rod::{Clamps, Law, Orientation, Parameter, RodModel, RodState, StartClamp};
 use crate::solve::continuation::ContinuationSettings;
 use crate::solve::outcome::SolverSettings;
 use serde::{Deserialize, Serialize};
@@ -163,6 +163,118 @@ pub struct ClampSpec {
     /// End rotation φ/2π (continuous: 1.3 is one turn more than 0.3).
     #[serde(default)]
     pub phi_over_2pi: f64,
+    /// Shift (x, y) of the s = 1 clamp's point, added to (−δ cos φ/2, −δ sin φ/2).
+    #[serde(default, deserialize_with = "exact::option")]
+    pub end_shift: Option<[f64; 2]>,
+    /// Rotation of the s = 1 clamp before its tilt and its turn φ.
+    #[serde(default)]
+    pub end_rotation: Option<RotationSpec>,
+    /// Tilt of the s = 1 clamp's tangent (radians) towards the azimuth
+    /// `end_tilt_azimuth` (radians about e3).
+    #[serde(default)]
+    pub end_tilt: f64,
+    /// Azimuth of the s = 1 tilt.
+    #[serde(default)]
+    pub end_tilt_azimuth: f64,
+    /// The s = 0 clamp (default: the identity frame at the origin).
+    #[serde(default)]
+    pub start: Option<StartClampSpec>,
+}
+
+/// `[clamps.start]`: the s = 0 clamp's frame.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct StartClampSpec {
+    /// Position r(0).
+    #[serde(deserialize_with = "exact::array")]
+    pub position: [f64; 3],
+    /// Rotation before the tilt and the turn.
+    pub rotation: Option<RotationSpec>,
+    /// Tilt of the tangent (radians).
+    pub tilt: f64,
+    /// Azimuth of the tilt (radians about e3).
+    pub tilt_azimuth: f64,
+    /// Turn of the material frame about the tangent, in turns.
+    pub turn_over_2pi: f64,
+}
+
+/// A clamp's rotation: a unit quaternion (w, x, y, z), an axis and an angle
+/// (ax, ay, az, radians), or Euler angles (a, b, c) of R = Rz(a) Ry(b) Rx(c)
+/// (intrinsic z–y′–x″, radians). It takes e3 to the clamp's tangent and e1 to
+/// its reference director.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum RotationSpec {
+    /// (w, x, y, z), of norm 1 within 1e-9.
+    Quaternion(#[serde(deserialize_with = "exact::array")] [f64; 4]),
+    /// (ax, ay, az, angle): a nonzero axis and an angle in radians.
+    AxisAngle(#[serde(deserialize_with = "exact::array")] [f64; 4]),
+    /// (a, b, c) in radians: R = Rz(a) Ry(b) Rx(c).
+    EulerZyx(#[serde(deserialize_with = "exact::array")] [f64; 3]),
+}
+
+impl RotationSpec {
+    /// The rotation, or why it is not one.
+    pub fn quaternion(&self) -> Result<nalgebra::UnitQuaternion<f64>, String> {
+        use nalgebra::{Quaternion, Unit, UnitQuaternion, Vector3};
+        let all_finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        match *self {
+            RotationSpec::Quaternion(q) => {
+                if !all_finite(&q) {
+                    return Err("quaternion components must be finite".into());
+                }
+                let q = Quaternion::new(q[0], q[1], q[2], q[3]);
+                if (q.norm() - 1.0).abs() > 1e-9 {
+                    return Err(format!(
+                        "a quaternion of norm {} is not a rotation (norm 1 within 1e-9)",
+                        q.norm()
+                    ));
+                }
+                Ok(UnitQuaternion::new_normalize(q))
+            }
+            RotationSpec::AxisAngle(a) => {
+                if !all_finite(&a) {
+                    return Err("axis and angle must be finite".into());
+                }
+                let axis = Vector3::new(a[0], a[1], a[2]);
+                if axis.norm() < 1e-12 {
+                    return Err("the axis must be nonzero".into());
+                }
+                Ok(UnitQuaternion::from_axis_angle(
+                    &Unit::new_normalize(axis),
+                    a[3],
+                ))
+            }
+            RotationSpec::EulerZyx([a, b, c]) => {
+                if !all_finite(&[a, b, c]) {
+                    return Err("Euler angles must be finite".into());
+                }
+                Ok(UnitQuaternion::from_euler_angles(c, b, a))
+            }
+        }
+    }
+}
+
+impl ClampSpec {
+    /// Set a clamp parameter (φ and turns in turns, tilts in radians).
+    pub fn set(&mut self, p: Parameter, v: f64) {
+        let start = || StartClampSpec::default();
+        match p {
+            Parameter::ZStar => self.z_star = v,
+            Parameter::Delta => self.delta = v,
+            Parameter::Phi => self.phi_over_2pi = v,
+            Parameter::EndX => self.end_shift.get_or_insert([0.0; 2])[0] = v,
+            Parameter::EndY => self.end_shift.get_or_insert([0.0; 2])[1] = v,
+            Parameter::EndTilt => self.end_tilt = v,
+            Parameter::EndTiltAzimuth => self.end_tilt_azimuth = v,
+            Parameter::StartX => self.start.get_or_insert_with(start).position[0] = v,
+            Parameter::StartY => self.start.get_or_insert_with(start).position[1] = v,
+            Parameter::StartZ => self.start.get_or_insert_with(start).position[2] = v,
+            Parameter::StartTilt => self.start.get_or_insert_with(start).tilt = v,
+            Parameter::StartTiltAzimuth => self.start.get_or_insert_with(start).tilt_azimuth = v,
+            Parameter::StartTurn => self.start.get_or_insert_with(start).turn_over_2pi = v,
+        }
+    }
 }
 
 /// `[initial]`
@@ -315,6 +427,10 @@ pub struct LoadingSpec {
     /// Target end rotation φ/2π (continuous).
     #[serde(default)]
     pub phi_over_2pi: Option<f64>,
+    /// Targets of any other clamp parameter (`targets = { end_tilt = 0.3 }`;
+    /// tilts in radians, turns in turns), unchanged if absent.
+    #[serde(default)]
+    pub targets: std::collections::BTreeMap<Parameter, f64>,
     /// Number of equal steps.
     pub steps: i64,
 }
@@ -663,11 +779,30 @@ impl Scene {
 
     /// The clamps.
     pub fn clamps(&self) -> Clamps {
-        Clamps::new(
-            self.clamps.z_star,
-            self.clamps.delta,
-            self.clamps.phi_over_2pi,
-        )
+        let c = &self.clamps;
+        let mut clamps = Clamps::new(c.z_star, c.delta, c.phi_over_2pi);
+        let rotation = |r: &Option<RotationSpec>| {
+            r.and_then(|r| r.quaternion().ok())
+                .unwrap_or_else(nalgebra::UnitQuaternion::identity)
+        };
+        clamps.end.shift = c.end_shift.unwrap_or([0.0; 2]);
+        clamps.end.orientation = Orientation {
+            rotation: rotation(&c.end_rotation),
+            tilt: c.end_tilt,
+            tilt_azimuth: c.end_tilt_azimuth,
+        };
+        if let Some(st) = &c.start {
+            clamps.start = StartClamp {
+                position: nalgebra::Vector3::from(st.position),
+                orientation: Orientation {
+                    rotation: rotation(&st.rotation),
+                    tilt: st.tilt,
+                    tilt_azimuth: st.tilt_azimuth,
+                },
+                turn: 2.0 * std::f64::consts::PI * st.turn_over_2pi,
+            };
+        }
+        clamps
     }
 }
 
@@ -680,6 +815,12 @@ impl SliceSpec {
         s.clamps.z_star = c.z_star;
         s.clamps.delta = c.delta;
         s.clamps.phi_over_2pi = c.phi_over_2pi();
+        if !matches!(
+            self.parameter,
+            Parameter::ZStar | Parameter::Delta | Parameter::Phi
+        ) {
+            s.clamps.set(self.parameter, self.values[k]);
+        }
         if let Some(p) = &self.start_phi_over_2pi {
             s.clamps.phi_over_2pi = p[k];
         }

@@ -1,6 +1,6 @@
 //! Scene validation: every value's range checked, the error naming the field.
 
-use crate::model::rod::Parameter;
+use crate::model::rod::{Clamps, Parameter};
 use crate::scene::InitialShape;
 use crate::scene::{Scene, SceneError, finite, invalid, positive};
 
@@ -130,17 +130,47 @@ impl Scene {
     fn check_clamps(&self) -> Result<(), SceneError> {
         let c = &self.clamps;
         finite("clamps.phi_over_2pi", c.phi_over_2pi)?;
-        reachable(["clamps.z_star", "clamps.delta"], c.z_star, c.delta)
+        for v in c.end_shift.iter().flatten() {
+            finite("clamps.end_shift", *v)?;
+        }
+        finite("clamps.end_tilt", c.end_tilt)?;
+        finite("clamps.end_tilt_azimuth", c.end_tilt_azimuth)?;
+        if let Some(r) = &c.end_rotation {
+            r.quaternion()
+                .map_err(|why| invalid("clamps.end_rotation", why))?;
+        }
+        if let Some(st) = &c.start {
+            for v in st.position {
+                finite("clamps.start.position", v)?;
+            }
+            finite("clamps.start.tilt", st.tilt)?;
+            finite("clamps.start.tilt_azimuth", st.tilt_azimuth)?;
+            finite("clamps.start.turn_over_2pi", st.turn_over_2pi)?;
+            if let Some(r) = &st.rotation {
+                r.quaternion()
+                    .map_err(|why| invalid("clamps.start.rotation", why))?;
+            }
+        }
+        let general = !self.clamps().is_paper();
+        if general && self.initial.shape == InitialShape::DoubleRing {
+            return Err(invalid(
+                "initial.shape",
+                "the double ring is unfolded to the paper's clamps only (no shift, tilt, rotation or [clamps.start])",
+            ));
+        }
+        if general && self.initial.shape == InitialShape::Trefoil {
+            return Err(invalid(
+                "initial.shape",
+                "the trefoil start is tied around the paper's clamps only (no shift, tilt, rotation or [clamps.start])",
+            ));
+        }
+        reachable(["clamps.z_star", "clamps.delta"], &self.clamps())
     }
 
-    /// The clamps' (z*, δ) where `parameter` takes the value `v` and the
-    /// other coordinates are the scene's own.
-    fn clamps_at(&self, parameter: Parameter, v: f64) -> (f64, f64) {
-        match parameter {
-            Parameter::ZStar => (v, self.clamps.delta),
-            Parameter::Delta => (self.clamps.z_star, v),
-            Parameter::Phi => (self.clamps.z_star, self.clamps.delta),
-        }
+    /// The clamps where `parameter` takes the value `v` and the other
+    /// coordinates are the scene's own.
+    fn clamps_at(&self, parameter: Parameter, v: f64) -> Clamps {
+        parameter.with(&self.clamps(), v)
     }
 
     /// `[initial]`: the data each shape needs.
@@ -260,11 +290,15 @@ impl Scene {
             }
         }
         // each leg ends where the rod can reach
-        let (mut z, mut d) = (self.clamps.z_star, self.clamps.delta);
+        let mut c = self.clamps();
         for l in &self.loading {
-            z = l.z_star.unwrap_or(z);
-            d = l.delta.unwrap_or(d);
-            reachable(["loading.z_star", "loading.delta"], z, d)?;
+            c.z_star = l.z_star.unwrap_or(c.z_star);
+            c.delta = l.delta.unwrap_or(c.delta);
+            for (p, v) in &l.targets {
+                finite("loading.targets", *v)?;
+                c = p.with(&c, *v);
+            }
+            reachable(["loading.z_star", "loading.delta"], &c)?;
         }
         Ok(())
     }
@@ -280,8 +314,10 @@ impl Scene {
             }
             for v in &sw.values {
                 finite("sweep.values", *v)?;
-                let (z, d) = self.clamps_at(sw.parameter, *v);
-                reachable(["sweep.values", "sweep.values"], z, d)?;
+                reachable(
+                    ["sweep.values", "sweep.values"],
+                    &self.clamps_at(sw.parameter, *v),
+                )?;
             }
             if Some(sw.parameter) == self.continuation.as_ref().map(|c| c.parameter) {
                 return Err(invalid(
@@ -305,8 +341,7 @@ impl Scene {
                 return Err(invalid("map.range", "must be [lo, hi] with lo < hi"));
             }
             for v in m.range {
-                let (z, d) = self.clamps_at(m.parameter, v);
-                reachable(["map.range", "map.range"], z, d)?;
+                reachable(["map.range", "map.range"], &self.clamps_at(m.parameter, v))?;
             }
             if m.lines == 0 || m.lines > 100_000 {
                 return Err(invalid("map.lines", "must be in 1..=100000"));
@@ -326,8 +361,10 @@ impl Scene {
                     return Err(invalid("map.slices.values", "must be increasing"));
                 }
                 for v in &sl.values {
-                    let (z, d) = self.clamps_at(sl.parameter, *v);
-                    reachable(["map.slices.values", "map.slices.values"], z, d)?;
+                    reachable(
+                        ["map.slices.values", "map.slices.values"],
+                        &self.clamps_at(sl.parameter, *v),
+                    )?;
                 }
                 if sl.parameter == m.parameter
                     || Some(sl.parameter) == self.continuation.as_ref().map(|c| c.parameter)
@@ -436,7 +473,25 @@ impl Scene {
 
 /// Clamps at (z*, δ) that a rod of length 1 can reach: finite, δ ≥ 0,
 /// |z*| ≤ 1 and sqrt(z*² + δ²) ≤ 1; `fields` name z* and δ.
-fn reachable(fields: [&'static str; 2], z_star: f64, delta: f64) -> Result<(), SceneError> {
+fn reachable(fields: [&'static str; 2], c: &Clamps) -> Result<(), SceneError> {
+    let (z_star, delta) = (c.z_star, c.delta);
+    if !c.is_paper() {
+        finite(fields[0], z_star)?;
+        finite(fields[1], delta)?;
+        if delta < 0.0 {
+            return Err(invalid(fields[1], format!("δ must be >= 0, got {delta}")));
+        }
+        let span = c.span();
+        if !span.is_finite() || span > 1.0 {
+            return Err(invalid(
+                fields[0],
+                format!(
+                    "the clamps are farther apart than the rod's length: |r(1) − r(0)| = {span} > 1"
+                ),
+            ));
+        }
+        return Ok(());
+    }
     finite(fields[0], z_star)?;
     finite(fields[1], delta)?;
     if delta < 0.0 {

@@ -7,7 +7,6 @@
 //! bordered in, stability from the inertia reduced to the tangent space.
 
 use crate::linalg::sparse::Ldlt;
-use crate::model::rod::ClampVelocity;
 use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::solve::kkt::Kkt;
 use crate::solve::minimizer::Minimizer;
@@ -195,7 +194,7 @@ impl<'a> Tracer<'a> {
         let n = self.dofs;
         self.values.resize(energy.pattern.nnz(), 0.0);
         let info = energy.hessian(state, &mut self.grad[..n], &mut self.values);
-        let velocity = self.parameter.velocity(&state.clamps);
+        let velocity = self.parameter.velocity(state);
         energy.gradient_parameter_derivative(state, &velocity, &mut self.fp[..n]);
         let gnorm = dot(&self.grad[..n], &self.grad[..n]).sqrt();
         let mut infeasibility = 0.0f64;
@@ -396,10 +395,7 @@ impl<'a> Tracer<'a> {
         }
         let mut next = state.clone();
         // the clamps' move as a velocity: ∂_c∇E is linear in it
-        let velocity = ClampVelocity {
-            end: target.end_point() - from.clamps.end_point(),
-            theta: target.phi - from.clamps.phi,
-        };
+        let velocity = from.clamps.velocity_to(&target, from);
         for it in 0..=self.settings.max_corrector_iterations {
             crate::linalg::counters::NEWTON_ITERATIONS
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);

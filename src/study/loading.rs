@@ -94,10 +94,7 @@ fn predict(newton: &mut Minimizer, state: &RodState, c: Clamps) -> Result<RodSta
     let mut g = vec![0.0; n];
     let mut v = vec![0.0; e.pattern.nnz()];
     e.hessian(state, &mut g, &mut v);
-    let velocity = crate::model::rod::ClampVelocity {
-        end: c.end_point() - state.clamps.end_point(),
-        theta: c.phi - state.clamps.phi,
-    };
+    let velocity = state.clamps.velocity_to(&c, state);
     let mut dq = vec![0.0; n];
     e.gradient_parameter_derivative(state, &velocity, &mut dq);
     let mut moved = state.clone();
@@ -193,18 +190,11 @@ fn link_jump(
 
 /// Largest clamp-parameter difference (φ in turns).
 fn clamp_gap(a: &Clamps, b: &Clamps) -> f64 {
-    (a.z_star - b.z_star)
-        .abs()
-        .max((a.delta - b.delta).abs())
-        .max((a.phi_over_2pi() - b.phi_over_2pi()).abs())
+    a.gap(b)
 }
 
 fn midpoint(a: &Clamps, b: &Clamps) -> Clamps {
-    Clamps {
-        z_star: 0.5 * (a.z_star + b.z_star),
-        delta: 0.5 * (a.delta + b.delta),
-        phi: 0.5 * (a.phi + b.phi),
-    }
+    a.midpoint(b)
 }
 
 /// Run the loading path from `state` (an equilibrium at its clamps): every
@@ -228,21 +218,21 @@ pub fn run_loading(
     };
     for (leg, stage) in path.iter().enumerate() {
         let c0 = state.clamps;
-        let target = Clamps {
+        let mut target = Clamps {
             z_star: stage.z_star.unwrap_or(c0.z_star),
             delta: stage.delta.unwrap_or(c0.delta),
             phi: stage
                 .phi_over_2pi
                 .map_or(c0.phi, |p| 2.0 * std::f64::consts::PI * p),
+            ..c0
         };
+        for (p, v) in &stage.targets {
+            target = p.with(&target, *v);
+        }
         let steps = stage.steps as usize;
         for k in 1..=steps {
             let f = k as f64 / steps as f64;
-            let c = Clamps {
-                z_star: c0.z_star + f * (target.z_star - c0.z_star),
-                delta: c0.delta + f * (target.delta - c0.delta),
-                phi: c0.phi + f * (target.phi - c0.phi),
-            };
+            let c = c0.lerp(&target, f);
             let at = Leg {
                 from: &state,
                 eq: &eq,

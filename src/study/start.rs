@@ -34,6 +34,17 @@ pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
 fn straight(n: usize, clamps: Clamps, bump: Option<[f64; 3]>) -> RodState {
     match bump {
         None => RodState::straight(n, clamps),
+        Some(b) if !clamps.is_paper() => {
+            let b = Vector3::from(b);
+            RodState::from_curve(
+                n,
+                clamps,
+                move |s| {
+                    clamps.hermite(s) + b * (0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos()))
+                },
+                move |s| clamps.blended_d1(s),
+            )
+        }
         Some(b) => {
             let (end, phi, b) = (clamps.end_point(), clamps.phi, Vector3::from(b));
             RodState::from_curve(
@@ -126,8 +137,14 @@ fn shooting(init: &InitialSpec, model: &RodModel, clamps: Clamps) -> Result<RodS
         )
         .context("initial.refine: shooting refinement did not converge")?;
     }
-    let sol =
-        ShootingSolution::integrate_loaded(n0, m0, model.k2, model.k3, weight, natural, steps);
+    let sol = ShootingSolution::integrate_from(
+        &clamps,
+        n0,
+        m0,
+        [model.k2, model.k3],
+        [weight, natural],
+        steps,
+    );
     Ok(RodState::from_curve(
         model.segments,
         clamps,
@@ -190,6 +207,7 @@ pub fn starting_equilibrium(
                 z_star: f * target.z_star,
                 delta: f * target.delta,
                 phi: ring.phi + f * (target.phi - ring.phi),
+                ..ring
             };
             let step = crate::study::loading::move_clamps(&mut newton, &state, c, &scene.solver)
                 .with_context(|| format!("unfolding the double ring, step {k} of {steps}"))?;

@@ -3,7 +3,7 @@
 //! fails, equilibria by Newton at fixed clamps.
 
 use crate::analysis::equilibrium::Measure;
-use crate::geometry::closure::closure_knot;
+use crate::geometry::closure::closure_knot_along;
 use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::MapSpec;
 use crate::scene::Scene;
@@ -130,7 +130,7 @@ impl Walk<'_, '_> {
         Ok(match c {
             Condition::Wall => {
                 let (lo, hi) = state.z_range();
-                lo.min(state.clamps.z_star - hi)
+                lo.min(state.clamps.top_wall() - hi)
             }
             Condition::Crossing(s) => {
                 let (points, _) = state.centreline();
@@ -214,7 +214,7 @@ impl Walk<'_, '_> {
         let skip = on.map(Condition::failure);
         let state = &site.point.state;
         let (lo, hi) = state.z_range();
-        if skip != Some(Failure::Wall) && (lo <= 0.0 || hi >= state.clamps.z_star) {
+        if skip != Some(Failure::Wall) && (lo <= 0.0 || hi >= state.clamps.top_wall()) {
             return Ok(Some(Failure::Wall));
         }
         if skip != Some(Failure::Stability) && site.point.negative_count > 0 {
@@ -222,7 +222,7 @@ impl Walk<'_, '_> {
         }
         let good = self.measure.good.clone();
         let trefoil = |s: &RodState| {
-            let knot = closure_knot(&s.centreline().0).ok();
+            let knot = closure_knot_along(&s.centreline().0, s.clamps.ray_directions()).ok();
             good.is_knot(knot.as_ref().map(|k| k.alexander.as_slice()))
         };
         let knotted = if skip == Some(Failure::Knot) {
