@@ -84,6 +84,10 @@ pub struct Event {
     pub branch: usize,
     /// Free text (e.g. negative eigenvalue counts on either side).
     pub detail: String,
+    /// The whole clamps where they are not the paper's (a branch in a tilt,
+    /// say): z*, δ and φ alone do not say where.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clamps: Option<Clamps>,
 }
 
 impl Event {
@@ -98,6 +102,7 @@ impl Event {
             twist,
             branch,
             detail,
+            clamps: (!c.is_paper()).then_some(*c),
         }
     }
 }

@@ -2,6 +2,7 @@
 
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
+use crate::model::rod::Parameter;
 use crate::model::rod::RodModel;
 use crate::scene::{ReferenceSpec, Scene};
 use serde::{Deserialize, Serialize};
@@ -253,6 +254,34 @@ pub fn print_events(events: &[Event], out: &mut impl Write) -> std::io::Result<(
             "  {:<6} {:<13} {:>6} {:>9.5} {:>9.5} {:>8.4}  {}",
             e.label, e.kind, e.branch, e.z_star, e.phi_over_2pi, e.twist, e.detail
         )?;
+    }
+    // general clamps: every coordinate that is not the paper's, per event
+    let general: Vec<&Event> = events.iter().filter(|e| e.clamps.is_some()).collect();
+    if let Some(first) = general.first().and_then(|e| e.clamps) {
+        let moving: Vec<Parameter> = Parameter::ALL[3..]
+            .iter()
+            .copied()
+            .filter(|p| {
+                general.iter().any(|e| {
+                    e.clamps
+                        .is_some_and(|c| p.value(&c) != 0.0 || p.value(&c) != p.value(&first))
+                })
+            })
+            .collect();
+        if !moving.is_empty() {
+            write!(out, "  at general clamps:  label ")?;
+            for p in &moving {
+                write!(out, " {:>12}", p.name())?;
+            }
+            writeln!(out)?;
+            for e in &general {
+                write!(out, "                      {:<6}", e.label)?;
+                for p in &moving {
+                    write!(out, " {:>12.6}", e.clamps.map_or(f64::NAN, |c| p.value(&c)))?;
+                }
+                writeln!(out)?;
+            }
+        }
     }
     Ok(())
 }
