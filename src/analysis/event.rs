@@ -84,8 +84,8 @@ pub struct Event {
     pub branch: usize,
     /// Free text (e.g. negative eigenvalue counts on either side).
     pub detail: String,
-    /// The whole clamps where they are not the paper's (a branch in a tilt,
-    /// say): z*, δ and φ alone do not say where.
+    /// The whole clamps where they are not the paper's or carry the model's
+    /// scalars (a branch in a tilt or in K3): z*, δ and φ alone do not say where.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clamps: Option<Clamps>,
 }
@@ -102,7 +102,7 @@ impl Event {
             twist,
             branch,
             detail,
-            clamps: (!c.is_paper()).then_some(*c),
+            clamps: (!c.is_paper() || !c.scalars.is_unset()).then_some(*c),
         }
     }
 }

@@ -260,11 +260,17 @@ pub fn print_events(events: &[Event], out: &mut impl Write) -> std::io::Result<(
     if let Some(first) = general.first().and_then(|e| e.clamps) {
         let moving: Vec<Parameter> = Parameter::ALL[3..]
             .iter()
+            .chain(&Parameter::MODEL)
             .copied()
             .filter(|p| {
+                // a clamp coordinate off the paper's, or a model scalar that
+                // moves (or the one event's, when there is one)
                 general.iter().any(|e| {
-                    e.clamps
-                        .is_some_and(|c| p.value(&c) != 0.0 || p.value(&c) != p.value(&first))
+                    e.clamps.is_some_and(|c| {
+                        let v = p.value(&c);
+                        let moves = v != p.value(&first) || general.len() == 1;
+                        !v.is_nan() && (moves || (!p.is_model() && v != 0.0))
+                    })
                 })
             })
             .collect();

@@ -12,7 +12,7 @@
 use crate::linalg::jet::{self, Jet3, Jet4, Jet8};
 use crate::linalg::sparse::{NO_SLOT, SymmetricPattern};
 use crate::model::frames::{self, Scalar, V3, lift};
-use crate::model::rod::{ClampVelocity, DofMap, Law, RodModel, RodState, tangent};
+use crate::model::rod::{ClampVelocity, Clamps, DofMap, Law, RodModel, RodState, tangent};
 use nalgebra::Vector3;
 
 /// Which energy terms to include.
@@ -498,6 +498,7 @@ impl RodEnergy {
     /// Total energy.
     pub fn energy(&self, state: &RodState) -> f64 {
         let n = self.model.segments;
+        let model = self.model_at(state);
         let mut e = 0.0;
         if self.terms.bending || self.terms.twisting {
             for i in 1..=n {
@@ -505,7 +506,7 @@ impl RodEnergy {
                 e += vertex_energy(
                     &q,
                     &VertexFrames::at(state, i),
-                    &self.model,
+                    &model,
                     self.terms,
                     self.multiplier(state, i),
                 );
@@ -517,15 +518,15 @@ impl RodEnergy {
             }
         }
         if self.terms.gravity {
-            e += self.gravity_energy(state);
+            e += self.gravity_energy(state, &model);
         }
         e
     }
 
     /// The weight's potential energy −∫ w g·r ds, by the midpoint rule on
     /// the nodes x_1..x_N (node i stands for s ∈ [(i−1)h, ih]).
-    pub fn gravity_energy(&self, state: &RodState) -> f64 {
-        let w = Vector3::from(self.model.weight);
+    pub fn gravity_energy(&self, state: &RodState, model: &RodModel) -> f64 {
+        let w = Vector3::from(model.weight);
         let h = self.model.segment_length();
         -h * (1..=self.model.segments)
             .map(|i| w.dot(&state.nodes[i]))
@@ -534,14 +535,14 @@ impl RodEnergy {
 
     /// The weight's force on node i (its gradient is −h w g on each of
     /// x_1..x_N, its Hessian zero).
-    fn gravity_gradient(&self) -> Vector3<f64> {
-        -self.model.segment_length() * Vector3::from(self.model.weight)
+    fn gravity_gradient(&self, model: &RodModel) -> Vector3<f64> {
+        -self.model.segment_length() * Vector3::from(model.weight)
     }
 
     /// Add the weight's gradient on the free translations; returns its
     /// squared norm (for the force scale).
-    fn scatter_gravity(&self, grad: &mut [f64]) -> f64 {
-        let g = self.gravity_gradient();
+    fn scatter_gravity(&self, grad: &mut [f64], model: &RodModel) -> f64 {
+        let g = self.gravity_gradient(model);
         let mut scale2 = 0.0;
         if g == Vector3::zeros() {
             return 0.0;
@@ -562,8 +563,9 @@ impl RodEnergy {
     pub fn vertex_local(&self, state: &RodState, i: usize) -> (f64, [f64; 11], [f64; 121]) {
         let c = VertexFrames::at(state, i);
         let w = self.multiplier(state, i);
+        let model = self.model_at(state);
         let (e, g8, h8) =
-            vertex_energy_hessian(vertex_variables(state, i), &c, &self.model, self.terms, w);
+            vertex_energy_hessian(vertex_variables(state, i), &c, &model, self.terms, w);
         let (g, h) = vertex_to_nodes(&g8, h8.as_flattened());
         (e, g, h)
     }
@@ -590,13 +592,64 @@ impl RodEnergy {
         (e, g, h)
     }
 
-    fn vertex_gradient(&self, state: &RodState, i: usize) -> (f64, [f64; 11]) {
+    fn vertex_gradient(&self, state: &RodState, i: usize, model: &RodModel) -> (f64, [f64; 11]) {
         let c = VertexFrames::at(state, i);
         let w = self.multiplier(state, i);
         let (e, g8) = jet::gradient(vertex_variables(state, i), |v| {
-            vertex_energy(v, &c, &self.model, self.terms, w)
+            vertex_energy(v, &c, model, self.terms, w)
         });
         (e, vertex_gradient_to_nodes(&g8))
+    }
+
+    /// The model at `state`: its own, with the scalars the state sets (a
+    /// branch in K3 or in the weight).
+    pub fn model_at(&self, state: &RodState) -> std::borrow::Cow<'_, RodModel> {
+        let scalars = &state.clamps.scalars;
+        if scalars.is_unset() {
+            std::borrow::Cow::Borrowed(&self.model)
+        } else {
+            std::borrow::Cow::Owned(scalars.apply(&self.model))
+        }
+    }
+
+    /// Add Σ Δp ∂p∇E over the model's scalars that change from the state's
+    /// clamps to `target` (the clamps' own move is `Clamps::velocity_to`).
+    pub fn add_scalar_changes(&self, state: &RodState, target: &Clamps, out: &mut [f64]) {
+        let n = out.len();
+        let mut d = Vec::new();
+        let mut work = Vec::new();
+        for p in crate::model::rod::Parameter::MODEL {
+            let (a, b) = (p.value(&state.clamps), p.value(target));
+            if a.is_finite() && b.is_finite() && a != b {
+                d.resize(n, 0.0);
+                work.resize(n, 0.0);
+                self.parameter_derivative(state, p, &mut d, &mut work);
+                out.iter_mut().zip(&d).for_each(|(o, v)| *o += (b - a) * v);
+            }
+        }
+    }
+
+    /// ∂(∇E)/∂p on the free dofs for any parameter: the clamps' mixed
+    /// Hessian applied to their velocity, or for a scalar of the model the
+    /// gradient at p = 1 less the gradient at p = 0 (∇E is affine in K2, K3,
+    /// the weight and the scale of û); `work` is scratch of the same length.
+    pub fn parameter_derivative(
+        &self,
+        state: &RodState,
+        parameter: crate::model::rod::Parameter,
+        out: &mut [f64],
+        work: &mut [f64],
+    ) {
+        if !parameter.is_model() {
+            self.gradient_parameter_derivative(state, &parameter.velocity(state), out);
+            return;
+        }
+        let at = |v: f64| parameter.with(&state.clamps, v).scalars.apply(&self.model);
+        self.gradient_with(state, &at(1.0), out);
+        self.gradient_with(state, &at(0.0), work);
+        for (o, w) in out.iter_mut().zip(work.iter()) {
+            *o -= w;
+        }
     }
 
     fn edge_gradient(&self, state: &RodState, j: usize) -> (f64, [f64; 6]) {
@@ -615,13 +668,14 @@ impl RodEnergy {
     /// Gradient with respect to all nodes and angles (clamp dofs included).
     pub fn full_gradient(&self, state: &RodState) -> FullGradient {
         let n = self.model.segments;
+        let model = self.model_at(state);
         let mut g = FullGradient {
             nodes: vec![Vector3::zeros(); n + 2],
             theta: vec![0.0; n + 1],
         };
         if self.terms.bending || self.terms.twisting {
             for i in 1..=n {
-                let (_, gl) = self.vertex_gradient(state, i);
+                let (_, gl) = self.vertex_gradient(state, i, &model);
                 for k in 0..3 {
                     g.nodes[i - 1 + k] += Vector3::new(gl[3 * k], gl[3 * k + 1], gl[3 * k + 2]);
                 }
@@ -637,7 +691,7 @@ impl RodEnergy {
             }
         }
         if self.terms.gravity {
-            let w = self.gravity_gradient();
+            let w = self.gravity_gradient(&model);
             for x in &mut g.nodes[1..=n] {
                 *x += w;
             }
@@ -647,12 +701,17 @@ impl RodEnergy {
 
     /// Gradient on the free dofs (into `grad`), with energy and force scale.
     pub fn gradient(&self, state: &RodState, grad: &mut [f64]) -> GradientInfo {
+        self.gradient_with(state, &self.model_at(state), grad)
+    }
+
+    /// As [`Self::gradient`] with the model's scalars of `model`.
+    fn gradient_with(&self, state: &RodState, model: &RodModel, grad: &mut [f64]) -> GradientInfo {
         let n = self.model.segments;
         grad.iter_mut().for_each(|v| *v = 0.0);
         let (mut energy, mut scale2) = (0.0, 0.0);
         if self.terms.bending || self.terms.twisting {
             for i in 1..=n {
-                let (e, gl) = self.vertex_gradient(state, i);
+                let (e, gl) = self.vertex_gradient(state, i, model);
                 energy += e;
                 scale2 += scatter(&self.map.vertex_stencil(i), &gl, grad);
             }
@@ -665,8 +724,8 @@ impl RodEnergy {
             }
         }
         if self.terms.gravity {
-            energy += self.gravity_energy(state);
-            scale2 += self.scatter_gravity(grad);
+            energy += self.gravity_energy(state, model);
+            scale2 += self.scatter_gravity(grad, model);
         }
         GradientInfo {
             energy,
@@ -705,8 +764,9 @@ impl RodEnergy {
             }
         }
         if self.terms.gravity {
-            energy += self.gravity_energy(state);
-            scale2 += self.scatter_gravity(grad);
+            let model = self.model_at(state);
+            energy += self.gravity_energy(state, &model);
+            scale2 += self.scatter_gravity(grad, &model);
         }
         GradientInfo {
             energy,

@@ -251,6 +251,70 @@ impl EndPlacement {
     }
 }
 
+/// Scalars of the model that a study may vary along a branch, a loading
+/// path, a sweep or a map, carried by each state with its clamps; None: the
+/// model's own value.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(default)]
+pub struct ModelScalars {
+    /// K2 = B22/B11.
+    pub k2: Option<f64>,
+    /// K3 = B33/B11.
+    pub k3: Option<f64>,
+    /// Weight w L³/B11 along `weight_direction`.
+    pub weight: Option<f64>,
+    /// Unit direction of the weight (used with `weight`).
+    pub weight_direction: [f64; 3],
+    /// Factor on the natural strains û.
+    pub natural_scale: Option<f64>,
+}
+
+impl ModelScalars {
+    /// No scalar set: the model's own throughout.
+    pub fn is_unset(&self) -> bool {
+        self.k2.is_none()
+            && self.k3.is_none()
+            && self.weight.is_none()
+            && self.natural_scale.is_none()
+    }
+
+    /// The model with these scalars.
+    pub fn apply(&self, model: &RodModel) -> RodModel {
+        let mut m = model.clone();
+        if let Some(v) = self.k2 {
+            m.k2 = v;
+        }
+        if let Some(v) = self.k3 {
+            m.k3 = v;
+        }
+        if let Some(w) = self.weight {
+            m.weight = self.weight_direction.map(|d| w * d);
+        }
+        if let Some(f) = self.natural_scale {
+            m.natural_strains = model.natural_strains.map(|u| f * u);
+        }
+        m
+    }
+
+    /// Every scalar set to the model's own value (the weight's direction from
+    /// `direction` when the model is weightless).
+    pub fn of(model: &RodModel, direction: [f64; 3]) -> ModelScalars {
+        let w = Vector3::from(model.weight);
+        let (weight, dir) = if w.norm() > 0.0 {
+            (w.norm(), (w / w.norm()).into())
+        } else {
+            (0.0, direction)
+        };
+        ModelScalars {
+            k2: Some(model.k2),
+            k3: Some(model.k3),
+            weight: Some(weight),
+            weight_direction: dir,
+            natural_scale: Some(1.0),
+        }
+    }
+}
+
 /// The two clamps. The s = 1 clamp sits at (x − δ cos φ/2, y − δ sin φ/2, z*)
 /// (eq. 2.13 when the shift (x, y) is zero), oriented by `end.orientation` and
 /// turned by φ about its tangent; the s = 0 clamp is `start` (by default the
@@ -270,6 +334,9 @@ pub struct Clamps {
     /// The s = 0 clamp (default: the paper's).
     #[serde(default, skip_serializing_if = "StartClamp::is_default")]
     pub start: StartClamp,
+    /// Model scalars this state sets (a branch in K3 or in the weight).
+    #[serde(default, skip_serializing_if = "ModelScalars::is_unset")]
+    pub scalars: ModelScalars,
 }
 
 impl Clamps {
@@ -281,6 +348,7 @@ impl Clamps {
             phi: 2.0 * PI * phi_over_2pi,
             end: EndPlacement::default(),
             start: StartClamp::default(),
+            scalars: ModelScalars::default(),
         }
     }
 
@@ -324,6 +392,19 @@ impl Clamps {
                 c = p.with(&c, a + f * (b - a));
             }
         }
+        let blend = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(a), Some(b)) if a != b => Some(a + f * (b - a)),
+            (a, None) => a,
+            (_, b) => b,
+        };
+        let (x, y) = (&self.scalars, &to.scalars);
+        c.scalars = ModelScalars {
+            k2: blend(x.k2, y.k2),
+            k3: blend(x.k3, y.k3),
+            weight: blend(x.weight, y.weight),
+            natural_scale: blend(x.natural_scale, y.natural_scale),
+            ..*y
+        };
         let turn = |a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>| {
             if a == b { *a } else { a.slerp(b, f) }
         };
@@ -350,6 +431,8 @@ impl Clamps {
     pub fn gap(&self, to: &Clamps) -> f64 {
         let mut g = Parameter::ALL
             .iter()
+            .chain(&Parameter::MODEL)
+            .filter(|p| !p.value(self).is_nan() || !p.value(to).is_nan())
             .map(|p| (p.value(self) - p.value(to)).abs())
             .fold(0.0, f64::max);
         for (a, b) in [
@@ -953,10 +1036,33 @@ pub enum Parameter {
     /// Turn of the s = 0 clamp about its tangent, in turns (/2π).
     #[serde(alias = "start_turn_over_2pi")]
     StartTurn,
+    /// K2 = B22/B11 (Kirchhoff law).
+    #[serde(rename = "K2", alias = "k2")]
+    K2,
+    /// K3 = B33/B11.
+    #[serde(rename = "K3", alias = "k3")]
+    K3,
+    /// The weight w L³/B11 along the scene's direction.
+    Weight,
+    /// Factor on the natural strains û (1: the scene's).
+    NaturalScale,
 }
 
 impl Parameter {
-    /// Every parameter, in the order of the scene format's documentation.
+    /// The model's scalars.
+    pub const MODEL: [Parameter; 4] = [
+        Parameter::K2,
+        Parameter::K3,
+        Parameter::Weight,
+        Parameter::NaturalScale,
+    ];
+
+    /// Whether it is a scalar of the model rather than a clamp coordinate.
+    pub fn is_model(&self) -> bool {
+        Parameter::MODEL.contains(self)
+    }
+
+    /// Every clamp coordinate, in the order of the scene format's documentation.
     pub const ALL: [Parameter; 13] = [
         Parameter::ZStar,
         Parameter::Delta,
@@ -989,6 +1095,12 @@ impl Parameter {
             Parameter::StartTilt => c.start.orientation.tilt,
             Parameter::StartTiltAzimuth => c.start.orientation.tilt_azimuth,
             Parameter::StartTurn => c.start.turn / (2.0 * PI),
+            // NaN where the state does not carry it (a scene sets the scalars
+            // it varies: `Scene::clamps`)
+            Parameter::K2 => c.scalars.k2.unwrap_or(f64::NAN),
+            Parameter::K3 => c.scalars.k3.unwrap_or(f64::NAN),
+            Parameter::Weight => c.scalars.weight.unwrap_or(f64::NAN),
+            Parameter::NaturalScale => c.scalars.natural_scale.unwrap_or(f64::NAN),
         }
     }
 
@@ -1009,6 +1121,10 @@ impl Parameter {
             Parameter::StartTilt => c.start.orientation.tilt = v,
             Parameter::StartTiltAzimuth => c.start.orientation.tilt_azimuth = v,
             Parameter::StartTurn => c.start.turn = 2.0 * PI * v,
+            Parameter::K2 => c.scalars.k2 = Some(v),
+            Parameter::K3 => c.scalars.k3 = Some(v),
+            Parameter::Weight => c.scalars.weight = Some(v),
+            Parameter::NaturalScale => c.scalars.natural_scale = Some(v),
         }
         c
     }
@@ -1084,6 +1200,11 @@ impl Parameter {
                 nodes: [z; 4],
                 theta: [2.0 * PI, 0.0],
             },
+            // the model's scalars move no clamp (their ∂p∇E is the energy's
+            // `parameter_derivative`)
+            Parameter::K2 | Parameter::K3 | Parameter::Weight | Parameter::NaturalScale => {
+                ClampVelocity::default()
+            }
         }
     }
 
@@ -1103,6 +1224,10 @@ impl Parameter {
             Parameter::StartTilt => "start_tilt",
             Parameter::StartTiltAzimuth => "start_tilt_azimuth",
             Parameter::StartTurn => "start_turn_over_2pi",
+            Parameter::K2 => "K2",
+            Parameter::K3 => "K3",
+            Parameter::Weight => "weight",
+            Parameter::NaturalScale => "natural_scale",
         }
     }
 }

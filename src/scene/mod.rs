@@ -15,7 +15,9 @@ pub use map::{MapSpec, SliceSpec};
 use crate::analysis::class::{Clearance, GoodKnot};
 use crate::analysis::equilibrium::Measure;
 use crate::model::contact::ContactModel;
-use crate::model::rod::{Clamps, Law, Orientation, Parameter, RodModel, RodState, StartClamp};
+use crate::model::rod::{
+    Clamps, Law, ModelScalars, Orientation, Parameter, RodModel, RodState, StartClamp,
+};
 use crate::solve::continuation::ContinuationSettings;
 use crate::solve::outcome::SolverSettings;
 use serde::{Deserialize, Serialize};
@@ -273,6 +275,8 @@ impl ClampSpec {
             Parameter::StartTilt => self.start.get_or_insert_with(start).tilt = v,
             Parameter::StartTiltAzimuth => self.start.get_or_insert_with(start).tilt_azimuth = v,
             Parameter::StartTurn => self.start.get_or_insert_with(start).turn_over_2pi = v,
+            // the model's scalars are the model's (`Scene::set`)
+            Parameter::K2 | Parameter::K3 | Parameter::Weight | Parameter::NaturalScale => {}
         }
     }
 }
@@ -777,6 +781,36 @@ impl Scene {
         }
     }
 
+    /// Set a parameter in the scene's own sections ([clamps], or [model] and
+    /// [load] for the model's scalars).
+    pub fn set(&mut self, p: Parameter, v: f64) {
+        match p {
+            Parameter::K2 => self.model.k2 = v,
+            Parameter::K3 => self.model.k3 = v,
+            Parameter::Weight => self.load.weight = v,
+            Parameter::NaturalScale => {
+                self.model.natural_strains = self.model.natural_strains.map(|u| u * v)
+            }
+            _ => self.clamps.set(p, v),
+        }
+    }
+
+    /// Every parameter the scene varies: its branch's, its sweep's, its map's
+    /// and slices', its loading targets.
+    pub fn varied(&self) -> Vec<Parameter> {
+        let mut v: Vec<Parameter> = Vec::new();
+        v.extend(self.continuation.as_ref().map(|c| c.parameter));
+        v.extend(self.sweep.as_ref().map(|s| s.parameter));
+        if let Some(m) = &self.map {
+            v.push(m.parameter);
+            v.extend(m.slices.as_ref().map(|s| s.parameter));
+        }
+        for l in &self.loading {
+            v.extend(l.targets.keys().copied());
+        }
+        v
+    }
+
     /// The clamps.
     pub fn clamps(&self) -> Clamps {
         let c = &self.clamps;
@@ -791,6 +825,16 @@ impl Scene {
             tilt: c.end_tilt,
             tilt_azimuth: c.end_tilt_azimuth,
         };
+        if self.varied().iter().any(Parameter::is_model) {
+            // the states carry the model's scalars the scene varies
+            let d = nalgebra::Vector3::from(self.load.direction);
+            let direction = if d.norm() > 0.0 {
+                (d / d.norm()).into()
+            } else {
+                [0.0, 0.0, -1.0]
+            };
+            clamps.scalars = ModelScalars::of(&self.rod_model(None), direction);
+        }
         if let Some(st) = &c.start {
             clamps.start = StartClamp {
                 position: nalgebra::Vector3::from(st.position),
@@ -819,7 +863,7 @@ impl SliceSpec {
             self.parameter,
             Parameter::ZStar | Parameter::Delta | Parameter::Phi
         ) {
-            s.clamps.set(self.parameter, self.values[k]);
+            s.set(self.parameter, self.values[k]);
         }
         if let Some(p) = &self.start_phi_over_2pi {
             s.clamps.phi_over_2pi = p[k];

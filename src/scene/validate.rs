@@ -21,6 +21,7 @@ impl Scene {
         self.check_reference()?;
         self.check_budget_spec()?;
         self.check_load()?;
+        self.check_varied()?;
         Ok(())
     }
 
@@ -165,6 +166,62 @@ impl Scene {
             ));
         }
         reachable(["clamps.z_star", "clamps.delta"], &self.clamps())
+    }
+
+    /// The model's scalars a study varies: each meaningful for the law, and
+    /// every value it is set to in range.
+    fn check_varied(&self) -> Result<(), SceneError> {
+        use crate::scene::ModelKind;
+        for p in self.varied().into_iter().filter(Parameter::is_model) {
+            let kind = self.model.kind;
+            let why = match p {
+                Parameter::K2 if kind != ModelKind::Kirchhoff => Some(
+                    "K2 is a stiffness of the Kirchhoff law only (u2 = 0 for the strip and the unbendable rod)",
+                ),
+                Parameter::K3 if kind == ModelKind::Strip => {
+                    Some("the strip law has no K3 (bending and twisting do not separate)")
+                }
+                Parameter::NaturalScale if kind == ModelKind::Strip => Some(
+                    "the strip law is not affine in its natural curvature: vary it by a sweep of scenes instead",
+                ),
+                _ => None,
+            };
+            if let Some(why) = why {
+                return Err(invalid(field_of(self, p), why));
+            }
+        }
+        let mut values: Vec<(&'static str, Parameter, f64)> = Vec::new();
+        if let Some(c) = &self.continuation {
+            values.extend(c.range.map(|v| ("continuation.range", c.parameter, v)));
+        }
+        if let Some(sw) = &self.sweep {
+            values.extend(sw.values.iter().map(|v| ("sweep.values", sw.parameter, *v)));
+        }
+        if let Some(m) = &self.map {
+            values.extend(m.range.map(|v| ("map.range", m.parameter, v)));
+        }
+        for l in &self.loading {
+            values.extend(l.targets.iter().map(|(p, v)| ("loading.targets", *p, *v)));
+        }
+        for (field, p, v) in values {
+            let ok = match p {
+                // K2 and K3 may pass through the range [1e-6, 1e6] of the scene's
+                Parameter::K2 | Parameter::K3 => (1e-6..=1e6).contains(&v),
+                Parameter::Weight => v.is_finite() && v.abs() <= 1e6,
+                Parameter::NaturalScale => v.is_finite() && v.abs() <= 1e3,
+                _ => true,
+            };
+            if !ok {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "{} = {v} is out of range (K2, K3 in [1e-6, 1e6]; |weight| ≤ 1e6; |natural_scale| ≤ 1e3)",
+                        p.name()
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The clamps where `parameter` takes the value `v` and the other
@@ -513,4 +570,23 @@ fn reachable(fields: [&'static str; 2], c: &Clamps) -> Result<(), SceneError> {
         ));
     }
     Ok(())
+}
+
+/// The scene field that names a varied parameter.
+fn field_of(scene: &Scene, p: Parameter) -> &'static str {
+    if scene
+        .continuation
+        .as_ref()
+        .is_some_and(|c| c.parameter == p)
+    {
+        "continuation.parameter"
+    } else if scene.sweep.as_ref().is_some_and(|s| s.parameter == p) {
+        "sweep.parameter"
+    } else if scene.map.as_ref().is_some_and(|m| m.parameter == p) {
+        "map.parameter"
+    } else if scene.map.is_some() {
+        "map.slices.parameter"
+    } else {
+        "loading.targets"
+    }
 }

@@ -195,7 +195,7 @@ impl<'a> Tracer<'a> {
         self.values.resize(energy.pattern.nnz(), 0.0);
         let info = energy.hessian(state, &mut self.grad[..n], &mut self.values);
         let velocity = self.parameter.velocity(state);
-        energy.gradient_parameter_derivative(state, &velocity, &mut self.fp[..n]);
+        energy.parameter_derivative(state, self.parameter, &mut self.fp[..n], &mut self.b[..n]);
         let gnorm = dot(&self.grad[..n], &self.grad[..n]).sqrt();
         let mut infeasibility = 0.0f64;
         if let Some(kkt) = &mut self.kkt {
@@ -413,6 +413,7 @@ impl<'a> Tracer<'a> {
                 let energy = &self.newton.energy;
                 let mut fc = std::mem::take(&mut self.b);
                 energy.gradient_parameter_derivative(&state, &velocity, &mut fc[..n]);
+                energy.add_scalar_changes(&state, &target, &mut fc[..n]);
                 if self.kkt.is_some() {
                     energy.constraint_parameter_derivative(&self.rows, &velocity, &mut fc[n..]);
                 }

@@ -97,6 +97,7 @@ fn predict(newton: &mut Minimizer, state: &RodState, c: Clamps) -> Result<RodSta
     let velocity = state.clamps.velocity_to(&c, state);
     let mut dq = vec![0.0; n];
     e.gradient_parameter_derivative(state, &velocity, &mut dq);
+    e.add_scalar_changes(state, &c, &mut dq);
     let mut moved = state.clone();
     moved.set_clamps(c);
     // with contact the free rod's tangent may run into an obstacle: only the
