@@ -5,6 +5,7 @@
 mod common;
 
 use knotrod::analysis::equilibrium::{Conformation, Measure, self_approach, walls};
+use knotrod::analysis::event::{Event, EventKind};
 use knotrod::geometry::distance::min_self_distance;
 use knotrod::geometry::ribbon::{Piece, Ribbon, piece_distance};
 use knotrod::model::rod::RodState;
@@ -309,4 +310,62 @@ fn a_bad_strip_width_names_the_field() {
             .to_string();
         assert!(e.contains("model.strip_width"), "{extra}: {e}");
     }
+}
+
+/// The Figure 8 strip's branch in φ at z* = 0.115 and N = 40, of a ribbon
+/// of width `w`: its equilibria and events.
+fn fig8_branch(w: f64) -> (Vec<knotrod::analysis::equilibrium::Equilibrium>, Vec<Event>) {
+    let text = common::scene_text_at("scenes/fig8_strip.toml", 40)
+        .replace(
+            "kind = \"strip\"",
+            &format!("kind = \"strip\"\nstrip_width = {w}"),
+        )
+        .replace(
+            "values = [0.115, 0.150, 0.180, 0.200, 0.215]",
+            "values = [0.115]",
+        );
+    common::run(&Scene::parse(&text).unwrap())
+}
+
+#[test]
+fn a_branch_locates_where_the_ribbon_touches_itself() {
+    // rotating the clamp up from φ/2π = 0.94, the ribbon of width 0.03
+    // touches itself (between the points at 0.9470, 0.0008 apart, and
+    // 0.9526, touching) well before its centreline passes through itself
+    // (the knot change at 0.9775)
+    let (eqs, events) = fig8_branch(0.03);
+    let touch: Vec<&Event> = events
+        .iter()
+        .filter(|e| e.detail == "the ribbon touches itself")
+        .collect();
+    assert_eq!(touch.len(), 1, "{events:?}");
+    let at = touch[0].phi_over_2pi;
+    let before: Vec<_> = eqs
+        .iter()
+        .filter(|e| e.phi_over_2pi < at && e.phi_over_2pi > 0.94)
+        .collect();
+    assert!(!before.is_empty() && before.iter().all(|e| e.min_self_distance > 0.0));
+    let after: Vec<_> = eqs
+        .iter()
+        .filter(|e| e.phi_over_2pi > at && e.leg == 0)
+        .collect();
+    assert!(!after.is_empty());
+    assert!(
+        after
+            .iter()
+            .all(|e| e.min_self_distance == 0.0 && !e.good_knot)
+    );
+    let passes = events
+        .iter()
+        .find(|e| e.kind == EventKind::KnotChange && e.phi_over_2pi > 0.94)
+        .unwrap();
+    assert!(at < passes.phi_over_2pi - 0.02, "{at} {passes:?}");
+    // the centreline itself never touches: no such event at width 0
+    let (_, events) = fig8_branch(0.0);
+    assert!(events.iter().all(|e| !e.detail.contains("ribbon")));
+    assert!(
+        events.iter().any(|e| e.kind == EventKind::KnotChange
+            && (e.phi_over_2pi - passes.phi_over_2pi).abs() < 1e-3),
+        "{events:?}"
+    );
 }
