@@ -67,6 +67,9 @@ pub struct GoodKnot {
     pub clearance: Clearance,
     /// The rod's diameter h.
     pub diameter: f64,
+    /// A strip's width (0: none): the self-distance the predicate is given
+    /// is then its ribbon's, which [`GoodKnot::describe`] says.
+    pub strip_width: f64,
 }
 
 impl GoodKnot {
@@ -77,6 +80,7 @@ impl GoodKnot {
             alexander: alexander_of(knot)?,
             clearance,
             diameter,
+            strip_width: 0.0,
         })
     }
 
@@ -102,9 +106,20 @@ impl GoodKnot {
 
     /// The definition in words, for summaries and reports.
     pub fn describe(&self) -> String {
-        let clear = match self.clearance {
-            Clearance::Centreline => "the centreline clear of itself (the paper's)".to_string(),
-            Clearance::Diameter => format!("no closer to itself than h = {}", self.diameter),
+        let clear = match (self.clearance, self.strip_width > 0.0) {
+            (Clearance::Centreline, false) => {
+                "the centreline clear of itself (the paper's)".to_string()
+            }
+            (Clearance::Centreline, true) => {
+                format!("its ribbon of width {} clear of itself", self.strip_width)
+            }
+            (Clearance::Diameter, false) => {
+                format!("no closer to itself than h = {}", self.diameter)
+            }
+            (Clearance::Diameter, true) => format!(
+                "its ribbon of width {} no closer to itself than h = {}",
+                self.strip_width, self.diameter
+            ),
         };
         format!("walled, ray closure {}, stable, {clear}", self.knot)
     }

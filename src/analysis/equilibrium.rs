@@ -7,6 +7,8 @@ use crate::geometry::distance::{
     Approach, CurveTree, distance_to_ray, min_self_distance, strand_side,
 };
 use crate::geometry::knot::{KnotType, knot_names};
+use crate::geometry::ribbon::Ribbon;
+use crate::geometry::walls::wall_clearance_between;
 use crate::geometry::writhe::writhe_closed;
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::linalg::eigen::{Spectrum, StabilityError};
@@ -43,11 +45,12 @@ pub struct Equilibrium {
     pub m0: [f64; 3],
     /// Tw = (1/2π) ∫ u3 ds.
     pub twist: f64,
-    /// Lowest interior node height.
+    /// Lowest interior node height (of a ribbon: the lowest across its
+    /// width, see [`Measure::strip_width`]).
     pub min_z: f64,
-    /// Highest interior node height.
+    /// Highest interior node height (of a ribbon: across its width).
     pub max_z: f64,
-    /// 0 < z < z* at every interior node.
+    /// 0 < z < z* at every interior node (of a ribbon: across its width).
     pub walled: bool,
     /// Lowest eigenvalues of the Hessian on the free dofs.
     pub lowest_eigenvalues: Vec<f64>,
@@ -73,7 +76,8 @@ pub struct Equilibrium {
     /// The ray closure is the knot asked for (`[diagnostics] knot`).
     #[serde(default)]
     pub knotted: bool,
-    /// Smallest distance between parts of the centreline at least the gap apart.
+    /// Smallest distance between parts of the centreline at least the gap
+    /// apart (of a strip with a width: between parts of its ribbon).
     pub min_self_distance: f64,
     /// Arc lengths (s, s') of that closest approach.
     pub min_self_distance_s: [f64; 2],
@@ -136,6 +140,86 @@ pub struct Measure {
     pub self_distance_gap: f64,
     /// Ray length of the writhe closure.
     pub ray_length: f64,
+    /// Width w/L of a strip's ribbon (along d1, centred on the centreline):
+    /// when positive the self-distance, the walls and the self-contact
+    /// events are measured on the ribbon; 0 measures the centreline.
+    pub strip_width: f64,
+}
+
+/// The walls as seen by one measurement: the interior heights' range, walled,
+/// and the clearance of the interior extrema (see [`Equilibrium::min_z`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Walls {
+    /// Lowest interior height.
+    pub min_z: f64,
+    /// Highest interior height.
+    pub max_z: f64,
+    /// Strictly between z = 0 and z = z*.
+    pub walled: bool,
+    /// Clearance of the interior extrema (negative: outside).
+    pub clearance: f64,
+}
+
+/// The ribbon of `state` (segment k of its centreline carries edge k's d1)
+/// with its centreline and arc lengths.
+fn ribbon_data(state: &RodState) -> (Vec<Vector3<f64>>, Vec<f64>, Vec<Vector3<f64>>) {
+    let (points, arc) = state.centreline();
+    // the centreline's segment k is (part of) edge k, the clamps' included
+    let d1 = (0..points.len() - 1)
+        .map(|k| state.directors(k)[0])
+        .collect();
+    (points, arc, d1)
+}
+
+/// The walls of `state`, on its ribbon when `strip_width` > 0 (else exactly
+/// the centreline's, [`RodState::wall_clearance`] and [`RodState::walled`]).
+pub fn walls(state: &RodState, strip_width: f64) -> Walls {
+    if strip_width <= 0.0 {
+        let (min_z, max_z) = state.z_range();
+        return Walls {
+            min_z,
+            max_z,
+            walled: state.walled(),
+            clearance: state.wall_clearance(),
+        };
+    }
+    let (points, _, d1) = ribbon_data(state);
+    let ribbon = Ribbon {
+        points: &points,
+        d1: &d1,
+        width: strip_width,
+    };
+    let (low, high) = ribbon.heights();
+    // the interior points 1..=N, as for the centreline
+    let n = state.segments();
+    let (low, high) = (&low[1..=n], &high[1..=n]);
+    let min_z = low.iter().copied().fold(f64::INFINITY, f64::min);
+    let max_z = high.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let z_star = state.clamps.top_wall();
+    Walls {
+        min_z,
+        max_z,
+        walled: min_z > 0.0 && max_z < z_star,
+        clearance: wall_clearance_between(low, high, z_star),
+    }
+}
+
+/// The closest self-approach of `state` between parts at least
+/// `measure.self_distance_gap` apart: of its ribbon when
+/// `measure.strip_width` > 0, else of its centreline.
+pub fn self_approach(state: &RodState, measure: &Measure) -> Option<Approach> {
+    let gap = measure.self_distance_gap;
+    if measure.strip_width <= 0.0 {
+        let (points, arc) = state.centreline();
+        return min_self_distance(&points, &arc, gap);
+    }
+    let (points, arc, d1) = ribbon_data(state);
+    Ribbon {
+        points: &points,
+        d1: &d1,
+        width: measure.strip_width,
+    }
+    .min_self_distance(&arc, gap)
 }
 
 /// Writhe, knot type, walls and distances of a state (see [`Equilibrium`]).
@@ -144,7 +228,7 @@ pub struct Conformation {
     pub writhe: f64,
     /// Knot type of the ray closure (None: it passes through itself).
     pub knot: Option<KnotType>,
-    /// Closest self-approach.
+    /// Closest self-approach (of the ribbon when it has a width).
     pub self_approach: Option<Approach>,
     /// Wall clearance.
     pub wall_distance: f64,
@@ -195,8 +279,17 @@ impl Conformation {
         // the knot type and ray distances need the rays only to leave the
         // curve's neighbourhood
         let reach = reach(&points);
-        let self_approach = min_self_distance(&points, &arc, measure.self_distance_gap);
-        let wall_distance = state.wall_clearance();
+        // the knot and the writhe are the centreline's, so are the strands
+        // whose passage changes them
+        let line_approach = min_self_distance(&points, &arc, measure.self_distance_gap);
+        let (self_approach, wall_distance) = if measure.strip_width > 0.0 {
+            (
+                self_approach(state, measure),
+                walls(state, measure.strip_width).clearance,
+            )
+        } else {
+            (line_approach, state.wall_clearance())
+        };
         let end = *points.last().unwrap();
         let gap = measure.self_distance_gap;
         let ray = |origin: &Vector3<f64>, dir: Vector3<f64>, s_base: f64| {
@@ -204,7 +297,7 @@ impl Conformation {
                 .map_or(f64::INFINITY, |d| d.0)
         };
         let ray_distance = [ray(&start, down, 0.0), ray(&end, up, 1.0)];
-        let self_distance = self_approach.map_or(f64::INFINITY, |a| a.distance);
+        let self_distance = line_approach.map_or(f64::INFINITY, |a| a.distance);
         let carried = previous.filter(|p| {
             if p.state.nodes.len() != state.nodes.len()
                 || p.knot_undefined
@@ -244,7 +337,9 @@ impl Conformation {
         let writhe_with = |p: &Equilibrium, jump: f64| {
             (p.link - p.phi_over_2pi).round() + jump + state.clamps.phi_over_2pi() - state.twist()
         };
-        let passage = match (carried, previous, self_approach) {
+        // `p.min_self_distance` above is the ribbon's for a strip with a
+        // width: never more than the centreline's, so only more cautious
+        let passage = match (carried, previous, line_approach) {
             (None, Some(p), Some(a)) => {
                 passage_jump(state, &points, &arc, p, &a, ray_distance, gap).map(|j| (p, j))
             }
@@ -489,12 +584,16 @@ pub fn analyse_from(
 ) -> Result<Equilibrium, AnalysisError> {
     let (plain, pencil_values) = stability(newton, state, report, measure.eigenvalues, hessian)?;
     let reactions = newton.energy.clamp_reactions(state);
-    let (min_z, max_z) = state.z_range();
+    let Walls {
+        min_z,
+        max_z,
+        walled,
+        ..
+    } = walls(state, measure.strip_width);
     let z_star = state.clamps.z_star;
     let stable = plain.negative_count == 0 && plain.values.first().is_none_or(|v| *v > 0.0);
     let shape = Conformation::measure(state, measure, previous);
     let twist = state.twist();
-    let walled = state.walled();
     let knotted = measure
         .good
         .is_knot(shape.knot.as_ref().map(|k| k.alexander.as_slice()));

@@ -14,7 +14,8 @@ use parry3d_f64::query::closest_points::closest_points_segment_segment_with_loca
 
 const LEAF: usize = 4;
 
-fn v(p: &Vector3<f64>) -> Vector {
+/// A point as parry's vector.
+pub(super) fn v(p: &Vector3<f64>) -> Vector {
     Vector::new(p.x, p.y, p.z)
 }
 
@@ -90,7 +91,7 @@ impl CurveTree<'_> {
     /// whose runs are not pruned: `prune(d)` is asked with the distance
     /// between two runs' boxes (nearest run pairs are visited first, so a
     /// shrinking bound prunes early); `leaf(i, j)` gets every surviving pair.
-    fn walk_pairs(
+    pub(super) fn walk_pairs(
         &self,
         arc: &[f64],
         gap: f64,

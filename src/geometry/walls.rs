@@ -5,13 +5,22 @@
 /// (negative when outside). The clamped ends, which start on the walls, do not
 /// count; `heights` are the interior node heights in order along the rod.
 pub fn wall_clearance(heights: &[f64], z_star: f64) -> f64 {
-    let n = heights.len();
+    wall_clearance_between(heights, heights, z_star)
+}
+
+/// As [`wall_clearance`] for a body of some thickness in z: the interior
+/// local minima of its lowest heights `low` against z = 0, the interior
+/// local maxima of its highest heights `high` against z = z* (a ribbon
+/// across its width: `geometry::ribbon::Ribbon::heights`).
+pub fn wall_clearance_between(low: &[f64], high: &[f64], z_star: f64) -> f64 {
+    let n = low.len().min(high.len());
     let mut clearance = f64::INFINITY;
     for i in 1..n.saturating_sub(1) {
-        let (a, z, b) = (heights[i - 1], heights[i], heights[i + 1]);
+        let (a, z, b) = (low[i - 1], low[i], low[i + 1]);
         if z <= a && z <= b {
             clearance = clearance.min(z);
         }
+        let (a, z, b) = (high[i - 1], high[i], high[i + 1]);
         if z >= a && z >= b {
             clearance = clearance.min(z_star - z);
         }

@@ -110,6 +110,10 @@ pub struct ModelSpec {
     /// (Kirchhoff rods; û2 = 0 for the unbendable law).
     #[serde(default, deserialize_with = "exact::array")]
     pub natural_strains: [f64; 3],
+    /// Strips only: width w/L of the ribbon along d1 on which the
+    /// self-distance, crossings and walls are measured (0: the centreline).
+    #[serde(default)]
+    pub strip_width: f64,
 }
 
 fn default_strip_regularisation() -> f64 {
@@ -744,8 +748,12 @@ impl Scene {
     /// untabled one falls back to the paper's trefoil).
     pub fn good_knot(&self) -> GoodKnot {
         let d = &self.diagnostics;
-        GoodKnot::new(&d.knot, d.clearance, self.model.rod_diameter)
-            .unwrap_or_else(|| GoodKnot::paper(self.model.rod_diameter))
+        let good = GoodKnot::new(&d.knot, d.clearance, self.model.rod_diameter)
+            .unwrap_or_else(|| GoodKnot::paper(self.model.rod_diameter));
+        GoodKnot {
+            strip_width: self.model.strip_width,
+            ..good
+        }
     }
 
     /// Its name as a file name under `recordings/`: letters, digits, `-`,
@@ -778,6 +786,7 @@ impl Scene {
             good: self.good_knot(),
             self_distance_gap: self.diagnostics.self_distance_gap,
             ray_length: self.diagnostics.ray_length,
+            strip_width: self.model.strip_width,
         }
     }
 

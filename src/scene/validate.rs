@@ -115,6 +115,7 @@ impl Scene {
                 "û2 must be 0 for the unbendable law (u2 = 0 is enforced)",
             ));
         }
+        self.check_strip_width()?;
         if let Some(s) = m.stretching_stiffness {
             positive("model.stretching_stiffness", s)?;
             if s > 1e12 {
@@ -123,6 +124,54 @@ impl Scene {
                     format!("must be <= 1e12 (EA L²/EI), got {s}"),
                 ));
             }
+        }
+        Ok(())
+    }
+
+    /// `model.strip_width`: a ribbon narrow beside the rod's length, for the
+    /// laws that have a flat section, measured where its measure is honoured.
+    fn check_strip_width(&self) -> Result<(), SceneError> {
+        let w = finite("model.strip_width", self.model.strip_width)?;
+        if !(0.0..0.5).contains(&w) {
+            // Sadowsky's energy is the limit of a strip narrow beside its
+            // length; a ribbon half as wide as the rod is long is a plate
+            return Err(invalid(
+                "model.strip_width",
+                format!(
+                    "must be in [0, 0.5) (rod lengths): the strip law holds for a strip \
+                     narrow beside its length, got {w}"
+                ),
+            ));
+        }
+        if w == 0.0 {
+            return Ok(());
+        }
+        if self.model.kind == crate::scene::ModelKind::Kirchhoff {
+            return Err(invalid(
+                "model.strip_width",
+                "a Kirchhoff rod has a circular section (model.rod_diameter); a width is \
+                 for kind = \"strip\" or \"unbendable\"",
+            ));
+        }
+        if self.map.is_some() {
+            return Err(invalid(
+                "model.strip_width",
+                "a map's boundary walk follows the centreline's crossings and walls, not the \
+                 ribbon's: use strip_width = 0 with [map], or a [continuation]",
+            ));
+        }
+        if self.contact.is_some() {
+            return Err(invalid(
+                "model.strip_width",
+                "contact acts on a tube of diameter h round the centreline, not on the \
+                 ribbon: use strip_width = 0 with [contact]",
+            ));
+        }
+        if self.clamps.start.is_some() {
+            return Err(invalid(
+                "model.strip_width",
+                "the ribbon's walls are heights along e3, the paper's s = 0 clamp:                  use strip_width = 0 with [clamps.start]",
+            ));
         }
         Ok(())
     }

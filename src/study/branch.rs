@@ -3,7 +3,9 @@
 //! points (S), walls touched (W), self-crossings (X) and knot changes — and the
 //! bifurcating branches followed from branch points when asked.
 
-use crate::analysis::equilibrium::{Conformation, Equilibrium, Measure, analyse_from};
+use crate::analysis::equilibrium::{
+    Conformation, Equilibrium, Measure, analyse_from, self_approach, walls,
+};
 use crate::analysis::event::{Event, EventKind};
 use crate::model::rod::{Parameter, RodState};
 use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
@@ -17,17 +19,22 @@ struct TestValues {
     wall: f64,
     knot: Vec<i64>,
     link: f64,
+    /// A strip's ribbon touches or passes through itself (its self-distance
+    /// is zero); always false for a centreline, whose passages show in the
+    /// link and knot.
+    touching: bool,
     /// The equilibrium they were measured on: states near it are measured
     /// from it (writhe carried, or jumped across one passage).
     at: Equilibrium,
 }
 
 impl TestValues {
-    fn of(eq: &Equilibrium) -> TestValues {
+    fn of(eq: &Equilibrium, measure: &Measure) -> TestValues {
         TestValues {
             wall: eq.wall_distance,
             knot: eq.alexander.clone(),
             link: eq.link,
+            touching: ribbon_touches(eq.min_self_distance, measure),
             at: eq.clone(),
         }
     }
@@ -39,6 +46,12 @@ fn knot_of(state: &RodState, measure: &Measure, from: &Equilibrium) -> (Vec<i64>
     let shape = Conformation::continued(state, measure, from);
     let knot = shape.knot.map_or(vec![], |k| k.alexander);
     (knot, state.twist() + shape.writhe)
+}
+
+/// Whether a self-distance measured by `measure` is a ribbon touching
+/// itself.
+fn ribbon_touches(self_distance: f64, measure: &Measure) -> bool {
+    measure.strip_width > 0.0 && self_distance <= 0.0
 }
 
 /// A knot for event details: its name, else its Alexander polynomial.
@@ -191,7 +204,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
     fn trace(&mut self, start: Point, branch: usize, leg: usize, emit_start: bool) -> Result<()> {
         let settings = self.options.settings.clone();
         let eq = self.measure(&start, branch, leg)?;
-        let mut wa = TestValues::of(&eq);
+        let mut wa = TestValues::of(&eq, &self.options.measure);
         if emit_start {
             (self.observer)(eq)?;
         }
@@ -223,7 +236,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 }
             };
             let eq = self.measure(&b, branch, leg)?;
-            let wb = TestValues::of(&eq);
+            let wb = TestValues::of(&eq, &self.options.measure);
             if self.options.locate_events {
                 self.locate_events(&a, &b, &wa, &wb, step.length, branch)?;
             }
@@ -269,6 +282,9 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         }
         if wa.knot != wb.knot || (wb.link - wa.link).abs() > 1.0 {
             self.locate_crossing(a, wa, wb, ds, branch)?;
+        }
+        if wa.touching != wb.touching {
+            self.locate_ribbon_contact(a, wa, ds, branch)?;
         }
         Ok(())
     }
@@ -331,9 +347,10 @@ impl<'a, 'r> BranchRun<'a, 'r> {
     /// The rod enters or leaves the walls.
     fn locate_wall(&mut self, a: &Point, wa: &TestValues, ds: f64, branch: usize) -> Result<()> {
         let inside = wa.wall > 0.0;
+        let width = self.options.measure.strip_width;
         let p = self
             .locate(a, ds, &mut |_, p| {
-                (p.state.wall_clearance() > 0.0) == inside
+                (walls(&p.state, width).clearance > 0.0) == inside
             })
             .context("locating a wall")?;
         let detail = if inside {
@@ -377,6 +394,34 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             self.events
                 .push(event(EventKind::KnotChange, &p, branch, detail));
         }
+        Ok(())
+    }
+
+    /// A strip's ribbon comes to touch itself, or comes clear of itself: its
+    /// surface's self-distance reaches zero (the crossing X of a ribbon,
+    /// which comes before its centreline passes through itself).
+    fn locate_ribbon_contact(
+        &mut self,
+        a: &Point,
+        wa: &TestValues,
+        ds: f64,
+        branch: usize,
+    ) -> Result<()> {
+        let measure = self.options.measure.clone();
+        let touching = wa.touching;
+        let p = self
+            .locate(a, ds, &mut |_, p| {
+                let d = self_approach(&p.state, &measure).map_or(f64::INFINITY, |a| a.distance);
+                ribbon_touches(d, &measure) == touching
+            })
+            .context("locating where the ribbon touches itself")?;
+        let detail = if touching {
+            "the ribbon comes clear of itself"
+        } else {
+            "the ribbon touches itself"
+        };
+        self.events
+            .push(event(EventKind::Crossing, &p, branch, detail.into()));
         Ok(())
     }
 

@@ -4,7 +4,7 @@
 //! being a minimum the rod jumps: the jump is detected (loss of stability of
 //! the carried state, large change of shape or of link) and recorded.
 
-use crate::analysis::equilibrium::{Equilibrium, Measure, analyse, analyse_from};
+use crate::analysis::equilibrium::{Equilibrium, Measure, analyse, analyse_from, walls};
 use crate::analysis::event::{Event, EventKind};
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::rod::{Clamps, RodState};
@@ -368,8 +368,9 @@ impl Hand<'_> {
     /// Entering or leaving the walls: locate it on the branch.
     fn locate_wall(&mut self, at: &Leg) -> Result<()> {
         let inside = at.eq.walled;
+        let width = self.measure.strip_width;
         let (_, hi) = locate_on_path(self.newton, at.from, at.to, self.settings, &mut |_, t| {
-            Ok(t.state.walled() == inside)
+            Ok(walls(&t.state, width).walled == inside)
         })
         .with_context(|| at.context())?;
         let detail = if inside {
