@@ -338,22 +338,28 @@ pub struct VertexMultiplier {
 }
 
 /// Bending and twisting energy (or the strip's, or the augmented
-/// Lagrangian's) at vertex i, from its variables.
+/// Lagrangian's) at vertex i, from its variables, with the natural strains
+/// `natural` there.
 pub fn vertex_energy<T: Scalar>(
     q: &[T],
     c: &VertexFrames,
-    model: &RodModel,
+    (model, natural): (&RodModel, [f64; 3]),
     terms: Terms,
     multiplier: Option<VertexMultiplier>,
 ) -> T {
-    energy_of_strains(strains(&edge_frames(q, c), c), model, terms, multiplier)
+    energy_of_strains(
+        strains(&edge_frames(q, c), c),
+        (model, natural),
+        terms,
+        multiplier,
+    )
 }
 
 /// Energy, gradient and Hessian of [`vertex_energy`] (through [`strain_jets`]).
 fn vertex_energy_hessian(
     q: [f64; 8],
     c: &VertexFrames,
-    model: &RodModel,
+    model: (&RodModel, [f64; 3]),
     terms: Terms,
     multiplier: Option<VertexMultiplier>,
 ) -> (f64, [f64; 8], [[f64; 8]; 8]) {
@@ -363,7 +369,7 @@ fn vertex_energy_hessian(
 
 fn energy_of_strains<T: Scalar>(
     u: Strains<T>,
-    model: &RodModel,
+    (model, natural): (&RodModel, [f64; 3]),
     terms: Terms,
     multiplier: Option<VertexMultiplier>,
 ) -> T {
@@ -373,12 +379,19 @@ fn energy_of_strains<T: Scalar>(
         Law::Strip { regularisation } => {
             // bending and twisting do not separate in the strip law
             if terms.bending || terms.twisting {
-                e += strip_energy(u.k1, u.m, regularisation, h);
+                // the law of u1 − û1 (the model's definition of a naturally
+                // curved strip); û1 = 0 leaves the operations of a straight one
+                let k1 = if natural[0] != 0.0 {
+                    u.k1 - T::from(natural[0] * h)
+                } else {
+                    u.k1
+                };
+                e += strip_energy(k1, u.m, regularisation, h);
             }
         }
         law => {
             // strains relative to the natural ones (integrated over h)
-            let [n1, n2, n3] = model.natural_strains.map(|v| T::from(v * h));
+            let [n1, n2, n3] = natural.map(|v| T::from(v * h));
             if terms.bending {
                 let k2_stiffness = if law == Law::Kirchhoff { model.k2 } else { 0.0 };
                 let (a1, a2) = (u.k1 - n1, u.k2 - n2);
@@ -469,6 +482,11 @@ impl RodEnergy {
         }
     }
 
+    /// The natural strains at vertex i (s = (i − ½)h).
+    pub fn natural_at(&self, i: usize) -> [f64; 3] {
+        self.model.natural_strains.at_vertex(i, self.model.segments)
+    }
+
     /// The multiplier term of vertex i, if the law is constrained.
     fn multiplier(&self, state: &RodState, i: usize) -> Option<VertexMultiplier> {
         self.penalty.map(|penalty| VertexMultiplier {
@@ -505,7 +523,7 @@ impl RodEnergy {
                 e += vertex_energy(
                     &q,
                     &VertexFrames::at(state, i),
-                    &self.model,
+                    (&self.model, self.natural_at(i)),
                     self.terms,
                     self.multiplier(state, i),
                 );
@@ -562,8 +580,13 @@ impl RodEnergy {
     pub fn vertex_local(&self, state: &RodState, i: usize) -> (f64, [f64; 11], [f64; 121]) {
         let c = VertexFrames::at(state, i);
         let w = self.multiplier(state, i);
-        let (e, g8, h8) =
-            vertex_energy_hessian(vertex_variables(state, i), &c, &self.model, self.terms, w);
+        let (e, g8, h8) = vertex_energy_hessian(
+            vertex_variables(state, i),
+            &c,
+            (&self.model, self.natural_at(i)),
+            self.terms,
+            w,
+        );
         let (g, h) = vertex_to_nodes(&g8, h8.as_flattened());
         (e, g, h)
     }
@@ -593,8 +616,9 @@ impl RodEnergy {
     fn vertex_gradient(&self, state: &RodState, i: usize) -> (f64, [f64; 11]) {
         let c = VertexFrames::at(state, i);
         let w = self.multiplier(state, i);
+        let natural = self.natural_at(i);
         let (e, g8) = jet::gradient(vertex_variables(state, i), |v| {
-            vertex_energy(v, &c, &self.model, self.terms, w)
+            vertex_energy(v, &c, (&self.model, natural), self.terms, w)
         });
         (e, vertex_gradient_to_nodes(&g8))
     }
