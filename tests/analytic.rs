@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 fn model(n: usize, k2: f64, k3: f64) -> RodModel {
     RodModel {
         weight: [0.0; 3],
-        natural_strains: [0.0; 3],
+        natural_strains: Default::default(),
         segments: n,
         k2,
         k3,

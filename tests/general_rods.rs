@@ -95,17 +95,15 @@ fn against_shooting_general(scene_of: impl Fn(usize) -> String) -> (Vec<f64>, Ve
             Vector3::from(eq.n0),
             Vector3::from(eq.m0),
             scene.clamps(),
-            [
-                Vector3::from(model.weight),
-                Vector3::from(model.natural_strains),
-            ],
+            (Vector3::from(model.weight), model.natural_strains),
         )
     };
     let runs: Vec<_> = [50, 100, 200].into_iter().map(solve).collect();
-    let (n0, m0, clamps, loads) = runs[2];
-    let (ns, ms) = refine_shooting_loaded(n0, m0, 3.0, 2.0, loads, &clamps, 20_000)
+    let (n0, m0, clamps, (weight, natural)) = runs[2].clone();
+    let (ns, ms) = refine_shooting_loaded(n0, m0, 3.0, 2.0, (weight, &natural), &clamps, 20_000)
         .expect("shooting converges from the DER reactions");
-    let sol = ShootingSolution::integrate_from(&clamps, ns, ms, [3.0, 2.0], loads, 20_000);
+    let sol =
+        ShootingSolution::integrate_from(&clamps, ns, ms, [3.0, 2.0], (weight, natural), 20_000);
     assert!(sol.boundary_residual(&clamps).norm() < 1e-10);
     let errors: Vec<f64> = runs
         .iter()
@@ -248,5 +246,20 @@ fn a_rod_of_natural_curvature_pi_rests_as_the_semicircle_of_its_clamps() {
     assert!(
         runs[2].0 < 1e-4 && runs[2].1 < 1e-2 && runs[2].2 < 1e-4,
         "{runs:?}"
+    );
+}
+
+#[test]
+fn a_rod_with_a_natural_strain_table_agrees_with_shooting_at_second_order() {
+    // û1(s) = 2 + s, û3(s) = 1 − s: the DER samples û at each vertex's
+    // s = (i − ½)h, the shooting ODE at every RK4 stage
+    let table = "natural_strains = [[0.0, 2.0, 0.0, 1.0], [1.0, 3.0, 0.0, 0.0]]";
+    let (errors, ns) = against_shooting(table, "");
+    // the variation matters: the constant mean (2.5, 0, 0.5) is far away
+    let (_, mean) = against_shooting("natural_strains = [2.5, 0.0, 0.5]", "");
+    let off = (mean - ns).norm() / ns.norm();
+    assert!(
+        off > 100.0 * errors[2],
+        "the table's slope changes n(0) by {off}"
     );
 }

@@ -16,7 +16,7 @@ use common::run;
 fn the_model_scalars_derivative_of_the_gradient_matches_finite_differences() {
     let model = RodModel {
         weight: [0.7, -1.9, 2.6],
-        natural_strains: [0.4, -0.9, 1.3],
+        natural_strains: [0.4, -0.9, 1.3].into(),
         segments: 12,
         k2: 2.3,
         k3: 1.7,

@@ -186,7 +186,7 @@ fn bad_values_of_the_new_settings_name_their_field() {
         ("natural_strains = [1e4, 0.0, 0.0]", "model.natural_strains"),
         ("natural_strains = [1.0, 0.0]", "natural_strains"),
         (
-            "kind = \"strip\"\nnatural_strains = [1.0, 0.0, 0.0]",
+            "kind = \"strip\"\nnatural_strains = [1.0, 0.0, 0.5]",
             "model.natural_strains",
         ),
         (

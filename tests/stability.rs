@@ -85,7 +85,7 @@ fn stable_knot(n: usize) {
     // the Appendix D knot at a coarse N, relaxed
     let model = RodModel {
         weight: [0.0; 3],
-        natural_strains: [0.0; 3],
+        natural_strains: Default::default(),
         segments: n,
         k2: 3.0,
         k3: 3.0,
@@ -114,7 +114,7 @@ fn unstable_state_spectrum_matches_dense() {
     for n in [20, 60] {
         let model = RodModel {
             weight: [0.0; 3],
-            natural_strains: [0.0; 3],
+            natural_strains: Default::default(),
             segments: n,
             k2: 1.0,
             k3: 1.0,

@@ -43,7 +43,7 @@ fn lowest(model: RodModel, state: &RodState) -> (f64, f64, usize) {
 fn kirchhoff(segments: usize, k2: f64, k3: f64, law: Law) -> RodModel {
     RodModel {
         weight: [0.0; 3],
-        natural_strains: [0.0; 3],
+        natural_strains: Default::default(),
         segments,
         k2,
         k3,

@@ -92,12 +92,12 @@ pub struct Equilibrium {
     /// constraint u2 = 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_u2: Option<f64>,
-    /// Strip law: smallest |u1| over the vertices. Where it is comparable to
+    /// Strip law: smallest |u1 − û1| over the vertices. Where it is comparable to
     /// the regularisation ε while the twist is not small, the Sadowsky energy
     /// is singular and the result depends on ε (see `regularised`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_u1: Option<f64>,
-    /// Strip law: some vertex has |u1| < 3ε with |u3| > ε, i.e. the
+    /// Strip law: some vertex has |u1 − û1| < 3ε with |u3| > ε, i.e. the
     /// regularisation, not the Sadowsky law, decides its shape there.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub regularised: Option<bool>,
@@ -528,10 +528,20 @@ fn stability(
 /// What a constrained law asks to check of its strains: the constraint's
 /// residual max |u2|, and for the strip min |u1| and whether the
 /// regularisation decides the shape somewhere.
-fn strain_checks(law: Law, state: &RodState) -> (Option<f64>, Option<f64>, Option<bool>) {
+fn strain_checks(energy: &RodEnergy, state: &RodState) -> (Option<f64>, Option<f64>, Option<bool>) {
+    let law = energy.model.law;
+    // the strip law is that of u1 − û1: its singular zero moves with û1
     let strains: Vec<[f64; 3]> = if law.constrained() {
         (1..=state.segments())
-            .map(|i| vertex_strains(state, i))
+            .map(|i| {
+                let [u1, u2, u3] = vertex_strains(state, i);
+                let shift = if matches!(law, Law::Strip { .. }) {
+                    energy.natural_at(i)[0]
+                } else {
+                    0.0
+                };
+                [u1 - shift, u2, u3]
+            })
             .collect()
     } else {
         Vec::new()
@@ -598,7 +608,7 @@ pub fn analyse_from(
         .good
         .is_knot(shape.knot.as_ref().map(|k| k.alexander.as_slice()));
     let min_self_distance = shape.self_approach.map_or(f64::INFINITY, |a| a.distance);
-    let (max_u2, min_u1, regularised) = strain_checks(newton.energy.model.law, state);
+    let (max_u2, min_u1, regularised) = strain_checks(&newton.energy, state);
     Ok(Equilibrium {
         z_star,
         delta: state.clamps.delta,

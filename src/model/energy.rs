@@ -338,22 +338,28 @@ pub struct VertexMultiplier {
 }
 
 /// Bending and twisting energy (or the strip's, or the augmented
-/// Lagrangian's) at vertex i, from its variables.
+/// Lagrangian's) at vertex i, from its variables, with the natural strains
+/// `natural` there.
 pub fn vertex_energy<T: Scalar>(
     q: &[T],
     c: &VertexFrames,
-    model: &RodModel,
+    (model, natural): (&RodModel, [f64; 3]),
     terms: Terms,
     multiplier: Option<VertexMultiplier>,
 ) -> T {
-    energy_of_strains(strains(&edge_frames(q, c), c), model, terms, multiplier)
+    energy_of_strains(
+        strains(&edge_frames(q, c), c),
+        (model, natural),
+        terms,
+        multiplier,
+    )
 }
 
 /// Energy, gradient and Hessian of [`vertex_energy`] (through [`strain_jets`]).
 fn vertex_energy_hessian(
     q: [f64; 8],
     c: &VertexFrames,
-    model: &RodModel,
+    model: (&RodModel, [f64; 3]),
     terms: Terms,
     multiplier: Option<VertexMultiplier>,
 ) -> (f64, [f64; 8], [[f64; 8]; 8]) {
@@ -363,7 +369,7 @@ fn vertex_energy_hessian(
 
 fn energy_of_strains<T: Scalar>(
     u: Strains<T>,
-    model: &RodModel,
+    (model, natural): (&RodModel, [f64; 3]),
     terms: Terms,
     multiplier: Option<VertexMultiplier>,
 ) -> T {
@@ -373,12 +379,19 @@ fn energy_of_strains<T: Scalar>(
         Law::Strip { regularisation } => {
             // bending and twisting do not separate in the strip law
             if terms.bending || terms.twisting {
-                e += strip_energy(u.k1, u.m, regularisation, h);
+                // the law of u1 − û1 (the model's definition of a naturally
+                // curved strip); û1 = 0 leaves the operations of a straight one
+                let k1 = if natural[0] != 0.0 {
+                    u.k1 - T::from(natural[0] * h)
+                } else {
+                    u.k1
+                };
+                e += strip_energy(k1, u.m, regularisation, h);
             }
         }
         law => {
             // strains relative to the natural ones (integrated over h)
-            let [n1, n2, n3] = model.natural_strains.map(|v| T::from(v * h));
+            let [n1, n2, n3] = natural.map(|v| T::from(v * h));
             if terms.bending {
                 let k2_stiffness = if law == Law::Kirchhoff { model.k2 } else { 0.0 };
                 let (a1, a2) = (u.k1 - n1, u.k2 - n2);
@@ -469,6 +482,11 @@ impl RodEnergy {
         }
     }
 
+    /// The natural strains at vertex i (s = (i − ½)h).
+    pub fn natural_at(&self, i: usize) -> [f64; 3] {
+        natural_at(&self.model, i)
+    }
+
     /// The multiplier term of vertex i, if the law is constrained.
     fn multiplier(&self, state: &RodState, i: usize) -> Option<VertexMultiplier> {
         self.penalty.map(|penalty| VertexMultiplier {
@@ -506,7 +524,7 @@ impl RodEnergy {
                 e += vertex_energy(
                     &q,
                     &VertexFrames::at(state, i),
-                    &model,
+                    (&*model, natural_at(&model, i)),
                     self.terms,
                     self.multiplier(state, i),
                 );
@@ -561,11 +579,26 @@ impl RodEnergy {
     /// Energy, node-variable gradient and Hessian (row-major 11×11) of the
     /// bending and twisting at vertex i.
     pub fn vertex_local(&self, state: &RodState, i: usize) -> (f64, [f64; 11], [f64; 121]) {
+        let model = self.model_at(state);
+        self.vertex_local_with(state, i, &model)
+    }
+
+    /// As [`Self::vertex_local`] with the model (and its scalars) given.
+    fn vertex_local_with(
+        &self,
+        state: &RodState,
+        i: usize,
+        model: &RodModel,
+    ) -> (f64, [f64; 11], [f64; 121]) {
         let c = VertexFrames::at(state, i);
         let w = self.multiplier(state, i);
-        let model = self.model_at(state);
-        let (e, g8, h8) =
-            vertex_energy_hessian(vertex_variables(state, i), &c, &model, self.terms, w);
+        let (e, g8, h8) = vertex_energy_hessian(
+            vertex_variables(state, i),
+            &c,
+            (model, natural_at(model, i)),
+            self.terms,
+            w,
+        );
         let (g, h) = vertex_to_nodes(&g8, h8.as_flattened());
         (e, g, h)
     }
@@ -595,8 +628,9 @@ impl RodEnergy {
     fn vertex_gradient(&self, state: &RodState, i: usize, model: &RodModel) -> (f64, [f64; 11]) {
         let c = VertexFrames::at(state, i);
         let w = self.multiplier(state, i);
+        let natural = natural_at(model, i);
         let (e, g8) = jet::gradient(vertex_variables(state, i), |v| {
-            vertex_energy(v, &c, model, self.terms, w)
+            vertex_energy(v, &c, (model, natural), self.terms, w)
         });
         (e, vertex_gradient_to_nodes(&g8))
     }
@@ -739,6 +773,7 @@ impl RodEnergy {
     pub fn hessian(&self, state: &RodState, grad: &mut [f64], values: &mut [f64]) -> GradientInfo {
         use rayon::prelude::*;
         let n = self.model.segments;
+        let model = self.model_at(state);
         grad.iter_mut().for_each(|v| *v = 0.0);
         values.iter_mut().for_each(|x| *x = 0.0);
         let (mut energy, mut scale2) = (0.0, 0.0);
@@ -746,7 +781,7 @@ impl RodEnergy {
             let local: Vec<(f64, [f64; 11], [f64; 121])> = (1..n + 1)
                 .into_par_iter()
                 .with_min_len(16)
-                .map(|i| self.vertex_local(state, i))
+                .map(|i| self.vertex_local_with(state, i, &model))
                 .collect();
             for (k, (e, gl, hl)) in local.iter().enumerate() {
                 let i = k + 1;
@@ -764,7 +799,6 @@ impl RodEnergy {
             }
         }
         if self.terms.gravity {
-            let model = self.model_at(state);
             energy += self.gravity_energy(state, &model);
             scale2 += self.scatter_gravity(grad, &model);
         }
@@ -944,4 +978,9 @@ impl RodEnergy {
             }
         }
     }
+}
+
+/// û of `model` at vertex i (its arc length (i − ½)h).
+fn natural_at(model: &RodModel, i: usize) -> [f64; 3] {
+    model.natural_strains.at_vertex(i, model.segments)
 }

@@ -9,6 +9,7 @@
 
 use crate::geometry::walls::wall_clearance;
 use crate::model::frames::{self, V3};
+use crate::model::natural::NaturalStrains;
 use nalgebra::{Rotation3, Unit, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -61,10 +62,11 @@ pub struct RodModel {
     /// the rod with its direction; potential energy −∫ w g·r ds.
     #[serde(default)]
     pub weight: [f64; 3],
-    /// Natural strains (û1, û2, û3), constant along the rod: the energy is
-    /// ½ ∫ B_i (u_i − û_i)² (zero: a naturally straight, untwisted rod).
+    /// Natural strains (û1, û2, û3), constant or a table in s: the energy is
+    /// ½ ∫ B_i (u_i − û_i)² (zero: a naturally straight, untwisted rod); the
+    /// strip law takes u1 − û1 in place of u1.
     #[serde(default)]
-    pub natural_strains: [f64; 3],
+    pub natural_strains: NaturalStrains,
 }
 
 /// Constitutive law of bending and twisting (energy per unit length, in units
@@ -120,9 +122,8 @@ impl RodModel {
             }
         };
         let mut out = law;
-        let u = self.natural_strains;
-        if u != [0.0; 3] {
-            out += &format!(", natural strains û = ({}, {}, {})", u[0], u[1], u[2]);
+        if !self.natural_strains.is_zero() {
+            out += &format!(", natural strains {}", self.natural_strains.describe());
         }
         let w = Vector3::from(self.weight);
         if w != Vector3::zeros() {
@@ -291,7 +292,7 @@ impl ModelScalars {
             m.weight = self.weight_direction.map(|d| w * d);
         }
         if let Some(f) = self.natural_scale {
-            m.natural_strains = model.natural_strains.map(|u| f * u);
+            m.natural_strains = model.natural_strains.scaled(f);
         }
         m
     }

@@ -2,6 +2,8 @@
 //! used to build initial shapes from published shooting data (n(0), m(0)) and as
 //! an independent reference (the paper's own method) in validation.
 
+use crate::model::natural::NaturalStrains;
+use crate::model::ode::{central_jacobian, hermite, rk4};
 use crate::model::rod::{Clamps, wrap};
 use nalgebra::{SVector, Vector3, Vector6};
 use std::f64::consts::PI;
@@ -20,7 +22,7 @@ pub fn rhs(y: &OdeState, k2: f64, k3: f64) -> OdeState {
 
 /// Right-hand side of (A.2) with a body force `weight` = w g per unit length
 /// (lab frame): n' = n × u − f in material components, f_i = w g·d_i; and
-/// natural strains û: u = B⁻¹m + û.
+/// natural strains û (their value at this s): u = B⁻¹m + û.
 pub fn rhs_loaded(
     y: &OdeState,
     k2: f64,
@@ -61,14 +63,15 @@ pub struct ShootingSolution {
     pub k3: f64,
     /// Body force per unit length (lab frame).
     pub weight: Vector3<f64>,
-    /// Natural strains û.
-    pub natural: Vector3<f64>,
+    /// Natural strains û(s).
+    pub natural: NaturalStrains,
 }
 
 impl ShootingSolution {
     /// Integrate from r = 0, d_i = e_i, with n(0), m(0) in the material frame.
     pub fn integrate(n0: Vector3<f64>, m0: Vector3<f64>, k2: f64, k3: f64, steps: usize) -> Self {
-        Self::integrate_loaded(n0, m0, k2, k3, Vector3::zeros(), Vector3::zeros(), steps)
+        let straight = NaturalStrains::default();
+        Self::integrate_loaded(n0, m0, k2, k3, Vector3::zeros(), straight, steps)
     }
 
     /// As `integrate`, under a body force `weight` per unit length (lab
@@ -79,7 +82,7 @@ impl ShootingSolution {
         k2: f64,
         k3: f64,
         weight: Vector3<f64>,
-        natural: Vector3<f64>,
+        natural: NaturalStrains,
         steps: usize,
     ) -> Self {
         Self::integrate_from(
@@ -87,7 +90,7 @@ impl ShootingSolution {
             n0,
             m0,
             [k2, k3],
-            [weight, natural],
+            (weight, natural),
             steps,
         )
     }
@@ -99,40 +102,16 @@ impl ShootingSolution {
         n0: Vector3<f64>,
         m0: Vector3<f64>,
         [k2, k3]: [f64; 2],
-        [weight, natural]: [Vector3<f64>; 2],
+        (weight, natural): (Vector3<f64>, NaturalStrains),
         steps: usize,
     ) -> Self {
-        let f = |y: &OdeState| rhs_loaded(y, k2, k3, &weight, &natural);
-        let mut y = OdeState::zeros();
-        if clamps.start.is_default() {
-            y[3] = 1.0;
-            y[7] = 1.0;
-            y[11] = 1.0;
-        } else {
-            let frame = clamps.start_frame();
-            let r = clamps.start_point();
-            for c in 0..3 {
-                y[c] = r[c];
-                for k in 0..3 {
-                    y[3 * (k + 1) + c] = frame[(c, k)];
-                }
-            }
-        }
+        let f = |s: f64, y: &OdeState| rhs_loaded(y, k2, k3, &weight, &natural.vector_at(s));
+        let mut y = start_frame(clamps);
         for c in 0..3 {
             y[12 + c] = n0[c];
             y[15 + c] = m0[c];
         }
-        let ds = 1.0 / steps as f64;
-        let mut samples = Vec::with_capacity(steps + 1);
-        samples.push(y);
-        for _ in 0..steps {
-            let a = f(&y);
-            let b = f(&(y + 0.5 * ds * a));
-            let c = f(&(y + 0.5 * ds * b));
-            let d = f(&(y + ds * c));
-            y += ds / 6.0 * (a + 2.0 * b + 2.0 * c + d);
-            samples.push(y);
-        }
+        let samples = rk4(y, steps, f);
         ShootingSolution {
             samples,
             k2,
@@ -144,19 +123,15 @@ impl ShootingSolution {
 
     /// State at s by cubic Hermite interpolation with the exact derivative (A.2).
     pub fn at(&self, s: f64) -> OdeState {
-        let steps = self.samples.len() - 1;
-        let x = s.clamp(0.0, 1.0) * steps as f64;
-        let k = (x.floor() as usize).min(steps - 1);
-        let t = x - k as f64;
-        let ds = 1.0 / steps as f64;
-        let (y0, y1) = (&self.samples[k], &self.samples[k + 1]);
-        let f = |y: &OdeState| rhs_loaded(y, self.k2, self.k3, &self.weight, &self.natural);
-        let (f0, f1) = (f(y0), f(y1));
-        let h00 = 2.0 * t * t * t - 3.0 * t * t + 1.0;
-        let h10 = t * t * t - 2.0 * t * t + t;
-        let h01 = -2.0 * t * t * t + 3.0 * t * t;
-        let h11 = t * t * t - t * t;
-        h00 * y0 + h10 * ds * f0 + h01 * y1 + h11 * ds * f1
+        hermite(&self.samples, s, |s, y| {
+            rhs_loaded(
+                y,
+                self.k2,
+                self.k3,
+                &self.weight,
+                &self.natural.vector_at(s),
+            )
+        })
     }
 
     /// Centreline r(s).
@@ -183,25 +158,30 @@ impl ShootingSolution {
     /// r(1) - r*, d3x(1), d3y(1), and the angle of d1 minus φ (mod 2π).
     pub fn boundary_residual(&self, clamps: &Clamps) -> Vector6<f64> {
         let y = self.end();
-        let r = part(y, 0) - clamps.end_point();
-        let mut d1 = part(y, 1);
-        let mut d3 = part(y, 3);
-        let o = &clamps.end.orientation;
-        if !o.is_identity() {
-            // components in the clamp's frame before its turn φ
-            let back = o.matrix().inverse();
-            d1 = back * d1;
-            d3 = back * d3;
-        }
-        Vector6::new(
-            r[0],
-            r[1],
-            r[2],
-            d3[0],
-            d3[1],
-            wrap(d1[1].atan2(d1[0]) - clamps.phi),
-        )
+        end_mismatch([part(y, 0), part(y, 1), part(y, 3)], clamps)
     }
+}
+
+/// The s = 1 conditions (2.10)-(2.11) for `clamps` at an end r, d1, d3 (the
+/// rod's and the strip's): r − r*, d3x, d3y, and the angle of d1 minus φ
+/// (mod 2π).
+pub fn end_mismatch([r, mut d1, mut d3]: [Vector3<f64>; 3], clamps: &Clamps) -> Vector6<f64> {
+    let r = r - clamps.end_point();
+    let o = &clamps.end.orientation;
+    if !o.is_identity() {
+        // components in the clamp's frame before its turn φ
+        let back = o.matrix().inverse();
+        d1 = back * d1;
+        d3 = back * d3;
+    }
+    Vector6::new(
+        r[0],
+        r[1],
+        r[2],
+        d3[0],
+        d3[1],
+        wrap(d1[1].atan2(d1[0]) - clamps.phi),
+    )
 }
 
 /// Refine published shooting data (n(0), m(0)) by Newton's method on the six
@@ -220,20 +200,20 @@ pub fn refine_shooting(
         m0,
         k2,
         k3,
-        [Vector3::zeros(), Vector3::zeros()],
+        (Vector3::zeros(), &NaturalStrains::default()),
         clamps,
         steps,
     )
 }
 
 /// As `refine_shooting`, under a body force and with natural strains
-/// (`[weight, natural]`).
+/// (`(weight, natural)`).
 pub fn refine_shooting_loaded(
     n0: Vector3<f64>,
     m0: Vector3<f64>,
     k2: f64,
     k3: f64,
-    [weight, natural]: [Vector3<f64>; 2],
+    (weight, natural): (Vector3<f64>, &NaturalStrains),
     clamps: &Clamps,
     steps: usize,
 ) -> Option<(Vector3<f64>, Vector3<f64>)> {
@@ -244,7 +224,7 @@ pub fn refine_shooting_loaded(
             p.fixed_rows::<3>(0).into(),
             p.fixed_rows::<3>(3).into(),
             [k2, k3],
-            [weight, natural],
+            (weight, natural.clone()),
             steps,
         )
         .boundary_residual(clamps)
@@ -254,17 +234,30 @@ pub fn refine_shooting_loaded(
         if r.norm() < 1e-11 {
             return Some((p.fixed_rows::<3>(0).into(), p.fixed_rows::<3>(3).into()));
         }
-        let mut jac = nalgebra::Matrix6::zeros();
-        for c in 0..6 {
-            let eps = 1e-6 * (1.0 + p[c].abs());
-            let mut pp = p;
-            pp[c] += eps;
-            let mut pm = p;
-            pm[c] -= eps;
-            jac.set_column(c, &((res(&pp) - res(&pm)) / (2.0 * eps)));
-        }
-        let dp = jac.lu().solve(&(-r))?;
+        let dp = central_jacobian(&p, res).lu().solve(&(-r))?;
         p += dp;
     }
     None
+}
+
+/// The ODE state at s = 0 of the clamps' s = 0 frame: r(0) at its point, the
+/// directors its material frame (the identity at the origin for the paper's),
+/// forces and moments zero.
+pub fn start_frame(clamps: &Clamps) -> OdeState {
+    let mut y = OdeState::zeros();
+    if clamps.start.is_default() {
+        y[3] = 1.0;
+        y[7] = 1.0;
+        y[11] = 1.0;
+        return y;
+    }
+    let frame = clamps.start_frame();
+    let r = clamps.start_point();
+    for c in 0..3 {
+        y[c] = r[c];
+        for k in 0..3 {
+            y[3 * (k + 1) + c] = frame[(c, k)];
+        }
+    }
+    y
 }

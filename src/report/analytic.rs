@@ -47,7 +47,7 @@ fn loss_of_stability(
 pub fn euler_buckling_load(n: usize, stretching_stiffness: f64) -> Result<f64> {
     let model = RodModel {
         weight: [0.0; 3],
-        natural_strains: [0.0; 3],
+        natural_strains: Default::default(),
         segments: n,
         k2: 1.0,
         k3: 3.0,
@@ -70,7 +70,7 @@ pub fn euler_buckling_load(n: usize, stretching_stiffness: f64) -> Result<f64> {
 pub fn greenhill_twisting_moment(n: usize, k3: f64, stretching_stiffness: f64) -> Result<f64> {
     let model = RodModel {
         weight: [0.0; 3],
-        natural_strains: [0.0; 3],
+        natural_strains: Default::default(),
         segments: n,
         k2: 1.0,
         k3,

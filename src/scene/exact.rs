@@ -41,3 +41,29 @@ pub fn option_list<'de, D: Deserializer<'de>, const N: usize>(
         .map(|l| l.into_iter().map(to_array).collect())
         .transpose()
 }
+
+/// Natural strains: exactly three numbers [û1, û2, û3], or a table of rows
+/// of exactly four [s, û1, û2, û3].
+pub fn natural<'de, D: Deserializer<'de>>(
+    d: D,
+) -> Result<crate::model::natural::NaturalStrains, D::Error> {
+    use crate::model::natural::NaturalStrains;
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Raw {
+        Triple(Vec<f64>),
+        Rows(Vec<Vec<f64>>),
+    }
+    match Raw::deserialize(d).map_err(|_| {
+        D::Error::custom(
+            "natural_strains: expected [û1, û2, û3] or a table of rows [s, û1, û2, û3]",
+        )
+    })? {
+        Raw::Triple(v) => to_array(v).map(NaturalStrains::Constant),
+        Raw::Rows(rows) => rows
+            .into_iter()
+            .map(to_array)
+            .collect::<Result<_, _>>()
+            .map(NaturalStrains::Table),
+    }
+}

@@ -15,6 +15,7 @@ pub use map::{MapSpec, SliceSpec};
 use crate::analysis::class::{Clearance, GoodKnot};
 use crate::analysis::equilibrium::Measure;
 use crate::model::contact::ContactModel;
+use crate::model::natural::NaturalStrains;
 use crate::model::rod::{
     Clamps, Law, ModelScalars, Orientation, Parameter, RodModel, RodState, StartClamp,
 };
@@ -106,10 +107,11 @@ pub struct ModelSpec {
     /// Stretching stiffness EA L²/B11 (overrides the one from the diameter).
     #[serde(default)]
     pub stretching_stiffness: Option<f64>,
-    /// Natural strains (û1, û2, û3) in units of 1/L, constant along the rod
-    /// (Kirchhoff rods; û2 = 0 for the unbendable law).
-    #[serde(default, deserialize_with = "exact::array")]
-    pub natural_strains: [f64; 3],
+    /// Natural strains (û1, û2, û3) in units of 1/L: constant along the rod,
+    /// or a table of rows [s, û1, û2, û3] linearly interpolated in s (û2 = 0
+    /// for the unbendable law, û2 = û3 = 0 for the strip).
+    #[serde(default, deserialize_with = "exact::natural")]
+    pub natural_strains: NaturalStrains,
     /// Strips only: width w/L of the ribbon along d1 on which the
     /// self-distance, crossings and walls are measured (0: the centreline).
     #[serde(default)]
@@ -298,6 +300,16 @@ pub struct InitialSpec {
     /// Shooting data: m(0) in the material frame.
     #[serde(default, deserialize_with = "exact::option")]
     pub m0: Option<[f64; 3]>,
+    /// Strip shooting data: u1(0), the curvature at s = 0 (the paper's
+    /// unknowns for strips are n(0), u1(0), m2(0), u3(0)).
+    #[serde(default)]
+    pub u1_0: Option<f64>,
+    /// Strip shooting data: m2(0), the moment about d2 (the multiplier of u2 = 0).
+    #[serde(default)]
+    pub m2_0: Option<f64>,
+    /// Strip shooting data: u3(0), the twist rate at s = 0.
+    #[serde(default)]
+    pub u3_0: Option<f64>,
     /// Refine the shooting data by Newton on the s = 1 boundary conditions first.
     #[serde(default)]
     pub refine: bool,
@@ -705,7 +717,7 @@ impl Scene {
         let m = &self.model;
         RodModel {
             weight: self.load.weight_vector(),
-            natural_strains: self.model.natural_strains,
+            natural_strains: self.model.natural_strains.clone(),
             segments: segments.unwrap_or(m.segments as usize),
             k2: m.k2,
             k3: m.k3,
@@ -798,7 +810,7 @@ impl Scene {
             Parameter::K3 => self.model.k3 = v,
             Parameter::Weight => self.load.weight = v,
             Parameter::NaturalScale => {
-                self.model.natural_strains = self.model.natural_strains.map(|u| u * v)
+                self.model.natural_strains = self.model.natural_strains.scaled(v)
             }
             _ => self.clamps.set(p, v),
         }

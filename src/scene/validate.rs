@@ -4,6 +4,9 @@ use crate::model::rod::{Clamps, Parameter};
 use crate::scene::InitialShape;
 use crate::scene::{Scene, SceneError, finite, invalid, positive};
 
+/// Most rows of a `model.natural_strains` table.
+pub const MAX_NATURAL_ROWS: usize = 100_000;
+
 impl Scene {
     /// Check every value's range (sections in the order of the file).
     pub fn validate(&self) -> Result<(), SceneError> {
@@ -94,27 +97,7 @@ impl Scene {
                 ),
             ));
         }
-        for v in m.natural_strains {
-            finite("model.natural_strains", v)?;
-            if v.abs() > 1e3 {
-                return Err(invalid(
-                    "model.natural_strains",
-                    format!("each |û_i| must be <= 1e3 (per rod length), got {v}"),
-                ));
-            }
-        }
-        if m.natural_strains != [0.0; 3] && m.kind == crate::scene::ModelKind::Strip {
-            return Err(invalid(
-                "model.natural_strains",
-                "the strip law has no natural strains yet: use kind = \"kirchhoff\"",
-            ));
-        }
-        if m.natural_strains[1] != 0.0 && m.kind == crate::scene::ModelKind::Unbendable {
-            return Err(invalid(
-                "model.natural_strains",
-                "û2 must be 0 for the unbendable law (u2 = 0 is enforced)",
-            ));
-        }
+        self.check_natural_strains()?;
         self.check_strip_width()?;
         if let Some(s) = m.stretching_stiffness {
             positive("model.stretching_stiffness", s)?;
@@ -202,6 +185,15 @@ impl Scene {
             }
         }
         let general = !self.clamps().is_paper();
+        if c.start.is_some()
+            && self.model.kind == crate::scene::ModelKind::Strip
+            && self.initial.shape == InitialShape::Shooting
+        {
+            return Err(invalid(
+                "clamps.start",
+                "strip shooting starts from the paper's s = 0 clamp (identity at the origin);                  start a strip with a general s = 0 clamp from another shape",
+            ));
+        }
         if general && self.initial.shape == InitialShape::DoubleRing {
             return Err(invalid(
                 "initial.shape",
@@ -279,19 +271,118 @@ impl Scene {
         parameter.with(&self.clamps(), v)
     }
 
+    /// `model.natural_strains`: finite and of sensible size; a table sorted
+    /// in s from 0 to 1 and not too long; only the components the law has.
+    fn check_natural_strains(&self) -> Result<(), SceneError> {
+        use crate::model::natural::NaturalStrains;
+        use crate::scene::ModelKind;
+        const FIELD: &str = "model.natural_strains";
+        let m = &self.model;
+        for v in m.natural_strains.values() {
+            finite(FIELD, v)?;
+            if v.abs() > 1e3 {
+                return Err(invalid(
+                    FIELD,
+                    format!("each |û_i| must be <= 1e3 (per rod length), got {v}"),
+                ));
+            }
+        }
+        if let NaturalStrains::Table(rows) = &m.natural_strains {
+            if !(2..=MAX_NATURAL_ROWS).contains(&rows.len()) {
+                return Err(invalid(
+                    FIELD,
+                    format!(
+                        "a table needs 2..={MAX_NATURAL_ROWS} rows [s, û1, û2, û3], got {}",
+                        rows.len()
+                    ),
+                ));
+            }
+            for r in rows {
+                finite(FIELD, r[0])?;
+            }
+            if let Some(w) = rows.windows(2).find(|w| w[1][0] <= w[0][0]) {
+                return Err(invalid(
+                    FIELD,
+                    format!(
+                        "the table's s must increase strictly, got {} then {}",
+                        w[0][0], w[1][0]
+                    ),
+                ));
+            }
+            let (first, last) = (rows[0][0], rows[rows.len() - 1][0]);
+            if first != 0.0 || last != 1.0 {
+                return Err(invalid(
+                    FIELD,
+                    format!(
+                        "the table must cover s in [0, 1] from its first row at s = 0 to its last at s = 1, got [{first}, {last}]"
+                    ),
+                ));
+            }
+        }
+        let component = |k| !m.natural_strains.component_is_zero(k);
+        if m.kind == ModelKind::Strip && (component(1) || component(2)) {
+            return Err(invalid(
+                FIELD,
+                "û2 and û3 must be 0 for the strip law (u2 = 0 is enforced and the \
+                 Sadowsky law has no natural twist): give only û1",
+            ));
+        }
+        if m.kind == ModelKind::Unbendable && component(1) {
+            return Err(invalid(
+                FIELD,
+                "û2 must be 0 for the unbendable law (u2 = 0 is enforced)",
+            ));
+        }
+        Ok(())
+    }
+
     /// `[initial]`: the data each shape needs.
     fn check_initial(&self) -> Result<(), SceneError> {
         let i = &self.initial;
+        let strip = self.model.kind == crate::scene::ModelKind::Strip;
+        let strip_fields = [
+            ("initial.u1_0", i.u1_0),
+            ("initial.m2_0", i.m2_0),
+            ("initial.u3_0", i.u3_0),
+        ];
+        for (field, v) in strip_fields {
+            if v.is_some() && !(strip && i.shape == InitialShape::Shooting) {
+                return Err(invalid(
+                    field,
+                    "only for shape = \"shooting\" with kind = \"strip\"",
+                ));
+            }
+        }
         if i.shape == InitialShape::Shooting {
             let n0 =
                 i.n0.ok_or_else(|| invalid("initial.n0", "required for shape = \"shooting\""))?;
-            let m0 =
-                i.m0.ok_or_else(|| invalid("initial.m0", "required for shape = \"shooting\""))?;
             for v in n0 {
                 finite("initial.n0", v)?;
             }
-            for v in m0 {
-                finite("initial.m0", v)?;
+            if strip {
+                // the strip's unknowns at s = 0 are the paper's (Sec. 4):
+                // n(0), u1(0), m2(0), u3(0); m1(0), m3(0) follow from the law
+                if i.m0.is_some() {
+                    return Err(invalid(
+                        "initial.m0",
+                        "not used for kind = \"strip\": give initial.u1_0, m2_0, u3_0",
+                    ));
+                }
+                for (field, v) in strip_fields {
+                    let v = v.ok_or_else(|| {
+                        invalid(field, "required for shape = \"shooting\" of a strip")
+                    })?;
+                    finite(field, v)?;
+                    if v.abs() > 1e4 {
+                        return Err(invalid(field, format!("must be in [-1e4, 1e4], got {v}")));
+                    }
+                }
+            } else {
+                let m0 =
+                    i.m0.ok_or_else(|| invalid("initial.m0", "required for shape = \"shooting\""))?;
+                for v in m0 {
+                    finite("initial.m0", v)?;
+                }
             }
         }
         // RK4 steps of a shooting start, or unfolding steps of the double ring

@@ -3,6 +3,7 @@
 
 use crate::analysis::equilibrium::AnalysisError;
 use crate::linalg::eigen::StabilityError;
+use crate::model::strip_shooting::StripShootingError;
 use crate::scene::SceneError;
 use crate::solve::continuation::ContinuationError;
 use crate::solve::outcome::SolveError;
@@ -25,6 +26,9 @@ pub enum StudyError {
     /// Measuring an equilibrium failed.
     #[error(transparent)]
     Analysis(#[from] AnalysisError),
+    /// Strip shooting (a continuum start) did not converge.
+    #[error(transparent)]
+    StripShooting(#[from] StripShootingError),
     /// The study cannot go on, and says why.
     #[error("{0}")]
     Failed(String),

@@ -4,8 +4,9 @@
 use crate::analysis::class::is_trefoil;
 use crate::analysis::equilibrium::{Conformation, Equilibrium, analyse};
 use crate::model::energy::RodEnergy;
-use crate::model::rod::{Clamps, RodModel, RodState};
+use crate::model::rod::{Clamps, Law, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting_loaded};
+use crate::model::strip_shooting::{StripProblem, StripUnknowns};
 use crate::scene::{InitialShape, InitialSpec, Scene, SceneError};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
@@ -116,22 +117,22 @@ fn trefoil(scene: &Scene, n: usize, clamps: Clamps) -> Result<RodState> {
 /// The continuum solution integrated (A.2) from n(0), m(0), refined first on
 /// the s = 1 boundary conditions if asked.
 fn shooting(init: &InitialSpec, model: &RodModel, clamps: Clamps) -> Result<RodState> {
+    if let Law::Strip { regularisation } = model.law {
+        return strip_shooting(init, model, clamps, regularisation);
+    }
     let (mut n0, mut m0) = (
         Vector3::from(init.n0.context("initial.n0 missing")?),
         Vector3::from(init.m0.context("initial.m0 missing")?),
     );
     let steps = init.steps.map_or(20_000, |s| s as usize);
-    let (weight, natural) = (
-        Vector3::from(model.weight),
-        Vector3::from(model.natural_strains),
-    );
+    let (weight, natural) = (Vector3::from(model.weight), &model.natural_strains);
     if init.refine {
         (n0, m0) = refine_shooting_loaded(
             n0,
             m0,
             model.k2,
             model.k3,
-            [weight, natural],
+            (weight, natural),
             &clamps,
             steps,
         )
@@ -142,9 +143,48 @@ fn shooting(init: &InitialSpec, model: &RodModel, clamps: Clamps) -> Result<RodS
         n0,
         m0,
         [model.k2, model.k3],
-        [weight, natural],
+        (weight, natural.clone()),
         steps,
     );
+    Ok(RodState::from_curve(
+        model.segments,
+        clamps,
+        |s| sol.position(s),
+        |s| sol.d1(s),
+    ))
+}
+
+/// The strip's continuum solution (A.1 with 4.1 and 4.3) integrated from the
+/// paper's unknowns n(0), u1(0), m2(0), u3(0), refined first if asked.
+fn strip_shooting(
+    init: &InitialSpec,
+    model: &RodModel,
+    clamps: Clamps,
+    regularisation: f64,
+) -> Result<RodState> {
+    let missing = |field: &'static str| SceneError::Invalid {
+        field,
+        reason: "required for shape = \"shooting\" of a strip".into(),
+    };
+    let mut p = StripUnknowns {
+        n0: Vector3::from(init.n0.ok_or_else(|| missing("initial.n0"))?),
+        u1: init.u1_0.ok_or_else(|| missing("initial.u1_0"))?,
+        m2: init.m2_0.ok_or_else(|| missing("initial.m2_0"))?,
+        u3: init.u3_0.ok_or_else(|| missing("initial.u3_0"))?,
+    };
+    let problem = StripProblem {
+        regularisation,
+        weight: Vector3::from(model.weight),
+        natural: model.natural_strains.clone(),
+        clamps,
+        steps: init.steps.map_or(20_000, |s| s as usize),
+    };
+    if init.refine {
+        p = problem
+            .refine(p)
+            .context("initial.refine: strip shooting refinement")?;
+    }
+    let sol = problem.integrate(&p);
     Ok(RodState::from_curve(
         model.segments,
         clamps,
@@ -224,7 +264,8 @@ pub fn starting_equilibrium(
 }
 
 /// The scene field a start shape comes from.
-fn start_field(init: &InitialSpec) -> &'static str {
+fn start_field(scene: &Scene) -> &'static str {
+    let init = &scene.initial;
     if init.from_recording.is_some() {
         return "initial.from_recording";
     }
@@ -232,6 +273,9 @@ fn start_field(init: &InitialSpec) -> &'static str {
         InitialShape::Straight if init.bump.is_some() => "initial.bump",
         InitialShape::Straight | InitialShape::DoubleRing | InitialShape::Trefoil => {
             "initial.shape"
+        }
+        InitialShape::Shooting if scene.model.kind == crate::scene::ModelKind::Strip => {
+            "initial.n0, initial.u1_0, initial.m2_0, initial.u3_0"
         }
         InitialShape::Shooting => "initial.n0, initial.m0",
         InitialShape::File => "initial.file",
@@ -255,7 +299,7 @@ fn check_start(scene: &Scene, energy: &RodEnergy, state: &RodState) -> Result<()
         fail!(
             "{}: the start shape has non-finite coordinates (an integration or a file past \
              f64's range): give smaller values",
-            start_field(&scene.initial)
+            start_field(scene)
         );
     }
     let mut gradient = vec![0.0; energy.map.len()];
@@ -273,7 +317,7 @@ fn check_start(scene: &Scene, energy: &RodEnergy, state: &RodState) -> Result<()
             "the start ({}) has a non-finite energy, gradient or Hessian with model.K2 = {}, model.K3 = {}, \
              stretching stiffness {:.3e} (model.stretching_stiffness or model.rod_diameter): \
              the start is too far stretched or the stiffnesses too large for f64",
-            start_field(&scene.initial),
+            start_field(scene),
             m.k2,
             m.k3,
             energy.model.stretching_stiffness

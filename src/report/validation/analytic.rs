@@ -30,7 +30,7 @@ fn twist_table() -> Result<String> {
     for (n, f, k3) in [(20, 0.3, 3.0), (50, 1.3, 1.0), (200, -0.75, 1.5)] {
         let model = RodModel {
             weight: [0.0; 3],
-            natural_strains: [0.0; 3],
+            natural_strains: Default::default(),
             segments: n,
             k2: 1.0,
             k3,

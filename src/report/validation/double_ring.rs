@@ -43,7 +43,7 @@ fn critical_k(n: usize) -> Result<f64> {
     let lowest = |k: f64| -> Result<f64> {
         let energy = RodEnergy::new(RodModel {
             weight: [0.0; 3],
-            natural_strains: [0.0; 3],
+            natural_strains: Default::default(),
             segments: n,
             k2: k,
             k3: k,
