@@ -12,6 +12,7 @@ mod double_ring;
 mod figure3;
 mod figure9;
 mod format;
+mod general;
 mod islands;
 mod loading;
 mod paper;
@@ -19,6 +20,7 @@ mod runs;
 mod strip;
 
 pub use convergence::{continuum_reference, convergence_table};
+pub use general::section as general_section;
 
 use crate::report::error::Result;
 use crate::scene::Scene;
@@ -47,6 +49,7 @@ pub fn report(scenes: &Path) -> Result<String> {
     s += &double_ring::section()?;
     s += &asymptotics::section()?;
     s += &contact::section(scenes)?;
+    s += &general::section(scenes)?;
     s += &convergence::sections(&d)?;
     Ok(s)
 }
