@@ -263,3 +263,57 @@ fn a_rod_with_a_natural_strain_table_agrees_with_shooting_at_second_order() {
         "the table's slope changes n(0) by {off}"
     );
 }
+
+#[test]
+fn the_appendix_d_knot_continued_in_its_weight_agrees_with_shooting_at_second_order() {
+    // the knot under its own weight along −x, loaded from w = 0 to 25 in
+    // steps (each predicted with the exact ∂∇E/∂w), then against shooting
+    let heavy = |n: usize| {
+        let text = std::fs::read_to_string("scenes/appendix_d.toml")
+            .unwrap()
+            .replace("segments = 200", &format!("segments = {n}"))
+            .replace("rod_diameter = 0.005   # stretching stiffness 16/h² = 640000", "stretching_stiffness = 1e7")
+            .replace("[solver]", "[load]\nweight = 0.0\ndirection = [-1.0, 0.0, 0.0]\n[[loading]]\ntargets = { weight = 25.0 }\nsteps = 25\n[solver]");
+        let scene = Scene::parse(&text).unwrap();
+        let mut last = None;
+        knotrod::study::run::run_scene(&scene, None, &mut |e| {
+            last = Some(e);
+            Ok(())
+        })
+        .unwrap();
+        let last = last.unwrap();
+        let w = knotrod::model::rod::Parameter::Weight.value(&last.state.clamps);
+        assert!((w - 25.0).abs() < 1e-12, "the branch ends at w = {w}");
+        (
+            Vector3::from(last.n0),
+            Vector3::from(last.m0),
+            scene.clamps(),
+        )
+    };
+    let runs: Vec<_> = [50, 100, 200].into_iter().map(heavy).collect();
+    let (n0, m0, clamps) = runs[2];
+    let weight = Vector3::new(-25.0, 0.0, 0.0);
+    let straight = Default::default();
+    let (ns, ms) = refine_shooting_loaded(n0, m0, 3.0, 3.0, (weight, &straight), &clamps, 20_000)
+        .expect("shooting converges from the DER reactions");
+    let errors: Vec<f64> = runs
+        .iter()
+        .map(|(n, m, _)| ((n - ns).norm() + (m - ms).norm()) / (ns.norm() + ms.norm()))
+        .collect();
+    eprintln!(
+        "heavy Appendix D knot (w = 25 along −x), N = 50, 100, 200: relative errors {errors:?}"
+    );
+    for k in 0..2 {
+        let order = (errors[k] / errors[k + 1]).log2();
+        assert!(
+            order > 1.9 && order < 2.1,
+            "errors {errors:?}, order {order}"
+        );
+    }
+    // the weight matters: the weightless knot is far away
+    let light = Scene::load(std::path::Path::new("scenes/appendix_d.toml")).unwrap();
+    let n_light = Vector3::from(solve_scene(&light, None).unwrap().n0);
+    let off = (n_light - ns).norm() / ns.norm();
+    eprintln!("the weight changes n(0) by {off} (relative)");
+    assert!(off > 10.0 * errors[2], "weight changes n(0) by {off}");
+}

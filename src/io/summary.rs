@@ -269,7 +269,7 @@ pub fn print_events(events: &[Event], out: &mut impl Write) -> std::io::Result<(
                     e.clamps.is_some_and(|c| {
                         let v = p.value(&c);
                         let moves = v != p.value(&first) || general.len() == 1;
-                        !v.is_nan() && (moves || (!p.is_model() && v != 0.0))
+                        !v.is_nan() && if p.is_model() { moves } else { v != 0.0 }
                     })
                 })
             })

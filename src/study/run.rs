@@ -100,6 +100,13 @@ pub fn run_scene(
         observer(analyse(&mut newton, &state, &report, &measure)?)?;
         return Ok(vec![]);
     };
+    if !spec.parameter.value(&state.clamps).is_finite() {
+        // a state that does not carry the model scalar the branch follows
+        fail!(
+            "continuation.parameter: the start state has no value of {} (a start that dropped the scene's model scalars)",
+            spec.parameter.name()
+        );
+    }
     let settings = spec.settings();
     let options = BranchOptions {
         parameter: spec.parameter,

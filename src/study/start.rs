@@ -247,6 +247,7 @@ pub fn starting_equilibrium(
                 z_star: f * target.z_star,
                 delta: f * target.delta,
                 phi: ring.phi + f * (target.phi - ring.phi),
+                scalars: target.scalars,
                 ..ring
             };
             let step = crate::study::loading::move_clamps(&mut newton, &state, c, &scene.solver)

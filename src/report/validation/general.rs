@@ -24,6 +24,8 @@ pub fn section(scenes: &Path) -> Result<String> {
     s += &semicircle_table()?;
     s += &rigid_motion_table(scenes)?;
     s += &k3_branch_table()?;
+    s += &heavy_knot_table(scenes)?;
+    s += &strip_weight_table(scenes)?;
     Ok(s)
 }
 
@@ -273,5 +275,136 @@ fn k3_branch_table() -> Result<String> {
         writeln!(s, "| {n} | {k3:.6} | {e:.2e} | {p} |")?;
         prev = Some(e);
     }
+    Ok(s)
+}
+
+/// The Appendix D knot loaded by its weight along −x to w = 25, against shooting.
+fn heavy_knot_table(scenes: &Path) -> Result<String> {
+    let mut s = String::new();
+    writeln!(
+        s,
+        "\n### The Appendix D knot under its weight (w L³/B = 25 along −x) against shooting\n\n\
+         Loaded from w = 0 in 25 steps (`[[loading]] targets = {{ weight = 25.0 }}`, each step predicted with the \
+         exact ∂∇E/∂w), EA L²/B = 1e7; the reference is shooting with the weight in the force balance, polished \
+         from the finest DER's reactions.\n"
+    )?;
+    let text = std::fs::read_to_string(scenes.join("appendix_d.toml"))?;
+    let runs = [50, 100, 200]
+        .into_iter()
+        .map(|n| {
+            let t = text
+                .replace("segments = 200", &format!("segments = {n}"))
+                .replace("rod_diameter = 0.005", "stretching_stiffness = 1e7 #")
+                .replace(
+                    "[solver]",
+                    "[load]\nweight = 0.0\ndirection = [-1.0, 0.0, 0.0]\n\
+                     [[loading]]\ntargets = { weight = 25.0 }\nsteps = 25\n[solver]",
+                );
+            let scene = Scene::parse(&t)?;
+            let mut last = None;
+            run_scene(&scene, None, &mut |e| {
+                last = Some(e);
+                Ok(())
+            })?;
+            let last = last.ok_or_else(|| failed("heavy knot: no equilibrium"))?;
+            Ok((n, last, scene))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let (_, last, scene) = &runs[2];
+    let model = scene.rod_model(None);
+    let weight = Vector3::new(-25.0, 0.0, 0.0);
+    let (ns, ms) = refine_shooting_loaded(
+        Vector3::from(last.n0),
+        Vector3::from(last.m0),
+        model.k2,
+        model.k3,
+        (weight, &model.natural_strains),
+        &scene.clamps(),
+        20_000,
+    )
+    .ok_or_else(|| failed("heavy knot: shooting did not converge from the DER"))?;
+    writeln!(
+        s,
+        "Shooting: n(0) = ({:.5}, {:.5}, {:.5}), m(0) = ({:.5}, {:.5}, {:.5}).\n",
+        ns.x, ns.y, ns.z, ms.x, ms.y, ms.z
+    )?;
+    writeln!(
+        s,
+        "| N | w reached | walled | stable | ‖Δn(0)‖ + ‖Δm(0)‖, relative | p |"
+    )?;
+    writeln!(s, "|---|---|---|---|---|---|")?;
+    let mut prev = None;
+    for (n, e, _) in &runs {
+        let w = Parameter::Weight.value(&e.state.clamps);
+        let err = ((Vector3::from(e.n0) - ns).norm() + (Vector3::from(e.m0) - ms).norm())
+            / (ns.norm() + ms.norm());
+        let p = prev.map_or(String::new(), |x| order(x, err));
+        writeln!(
+            s,
+            "| {n} | {w} | {} | {} | {err:.3e} | {p} |",
+            e.walled, e.stable
+        )?;
+        prev = Some(err);
+    }
+    Ok(s)
+}
+
+/// The Figure 10 strip knot followed in its weight from 0 to 25.
+fn strip_weight_table(scenes: &Path) -> Result<String> {
+    let mut s = String::new();
+    let scene = Scene::load(&scenes.join("fig10_strip_weight.toml"))?;
+    writeln!(
+        s,
+        "\n### The Figure 10 strip knot under its weight\n\n\
+         `scenes/fig10_strip_weight.toml`: the strip (Sadowsky law, N = {}) at δ = 0.10, z* = 0.17, φ/2π = 0.78 from \
+         the unfolded double ring, followed in the weight w L³/B from 0 to 25 along −e3 (the lab's ≈ 25). Every \
+         sixth point of the branch and its last:\n",
+        scene.model.segments
+    )?;
+    let mut eqs = Vec::new();
+    let events = run_scene(&scene, None, &mut |e| {
+        eqs.push(e);
+        Ok(())
+    })?;
+    writeln!(
+        s,
+        "| w L³/B | n(0) | Tw | Lk | walled | stable | knot | good | self-distance |"
+    )?;
+    writeln!(s, "|---|---|---|---|---|---|---|---|---|")?;
+    let last = eqs.len().saturating_sub(1);
+    for (_, e) in eqs
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| k % 6 == 0 || *k == last)
+    {
+        writeln!(
+            s,
+            "| {:.3} | ({:.3}, {:.3}, {:.3}) | {:.4} | {:.4} | {} | {} | {} | {} | {:.4} |",
+            Parameter::Weight.value(&e.state.clamps),
+            e.n0[0],
+            e.n0[1],
+            e.n0[2],
+            e.twist,
+            e.link,
+            e.walled,
+            e.stable,
+            e.knot_name.clone().unwrap_or_else(|| "none".into()),
+            e.good_knot,
+            e.min_self_distance
+        )?;
+    }
+    writeln!(
+        s,
+        "\nEvents on the branch: {}.\n",
+        if events.is_empty() {
+            "none (the knot stays walled, stable and knotted up to w = 25)".to_string()
+        } else {
+            events
+                .iter()
+                .map(|e| format!("{} ({})", e.label, e.kind))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
+    )?;
     Ok(s)
 }
