@@ -15,7 +15,9 @@ pub use map::{MapSpec, SliceSpec};
 use crate::analysis::class::{Clearance, GoodKnot};
 use crate::analysis::equilibrium::Measure;
 use crate::model::contact::ContactModel;
-use crate::model::rod::{Clamps, Law, Orientation, Parameter, RodModel, RodState, StartClamp};
+use crate::model::rod::{
+    Clamps, EndKind, Law, Orientation, Parameter, RodModel, RodState, StartClamp,
+};
 use crate::solve::continuation::ContinuationSettings;
 use crate::solve::outcome::SolverSettings;
 use serde::{Deserialize, Serialize};
@@ -179,6 +181,11 @@ pub struct ClampSpec {
     /// The s = 0 clamp (default: the identity frame at the origin).
     #[serde(default)]
     pub start: Option<StartClampSpec>,
+    /// Boundary condition at s = 1: "clamped" (default), "pinned" (the
+    /// point r* fixed, the frame free: a ball joint) or "free" (z*, δ, φ and
+    /// the end's placement then unused).
+    #[serde(default, skip_serializing_if = "EndKind::is_clamped")]
+    pub end: EndKind,
 }
 
 /// `[clamps.start]`: the s = 0 clamp's frame.
@@ -196,6 +203,9 @@ pub struct StartClampSpec {
     pub tilt_azimuth: f64,
     /// Turn of the material frame about the tangent, in turns.
     pub turn_over_2pi: f64,
+    /// Boundary condition at s = 0: "clamped" (default), "pinned" or "free".
+    #[serde(skip_serializing_if = "EndKind::is_clamped")]
+    pub kind: EndKind,
 }
 
 /// A clamp's rotation: a unit quaternion (w, x, y, z), an axis and an angle
@@ -801,7 +811,9 @@ impl Scene {
                 },
                 turn: 2.0 * std::f64::consts::PI * st.turn_over_2pi,
             };
+            clamps.ends.start = st.kind;
         }
+        clamps.ends.end = c.end;
         clamps
     }
 }
