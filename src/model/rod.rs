@@ -4,8 +4,13 @@
 //! s = (i - 1/2) h, edges e_j = x_{j+1} - x_j centred at s = j h. Edge 0 and edge
 //! N are the clamps: each is centred on its end point, half outside the rod, so
 //! that the N interior vertices (1..=N, curvature and twist) sample [0, 1] by the
-//! midpoint rule and the scheme stays second order. Fixed: nodes 0, 1, N, N+1
-//! and the material angles of edges 0 and N.
+//! midpoint rule and the scheme stays second order. Fixed between two clamps:
+//! nodes 0, 1, N, N+1 and the material angles of edges 0 and N. A pinned end
+//! keeps its edge's midpoint at the pin (the node beyond the end placed
+//! opposite its neighbour) with its angle free; a free end fixes nothing, the
+//! ghost half of its edge beyond s ∈ [0, 1] carrying no weight. Either way
+//! the discrete moment at the last vertex is the continuum's at h/2 from the
+//! end, which the natural condition m = 0 makes O(h²).
 
 use crate::geometry::walls::wall_clearance;
 use crate::model::frames::{self, V3};
@@ -805,13 +810,15 @@ impl RodState {
         let t_end = clamps.end_tangent();
         let mut nodes: Vec<Vector3<f64>> = (0..n + 2).map(|i| r((i as f64 - 0.5) * h)).collect();
         let ends = clamps.ends;
-        if ends.start != EndKind::Clamped {
-            // a free end edge samples the curve; a pinned one turns about its pin
-        } else if clamps.start.is_default() {
-            nodes[0] = -0.5 * h * e3;
-            nodes[1] = 0.5 * h * e3;
-        } else {
-            (nodes[0], nodes[1]) = clamp_edge(clamps.start_point(), clamps.start_tangent(), n);
+        // a free end edge samples the curve; a pinned one turns about its
+        // pin, its ghost node placed below
+        if ends.start == EndKind::Clamped {
+            if clamps.start.is_default() {
+                nodes[0] = -0.5 * h * e3;
+                nodes[1] = 0.5 * h * e3;
+            } else {
+                (nodes[0], nodes[1]) = clamp_edge(clamps.start_point(), clamps.start_tangent(), n);
+            }
         }
         if ends.end == EndKind::Clamped {
             nodes[n] = end - 0.5 * h * t_end;
@@ -956,13 +963,14 @@ impl RodState {
             self.nodes[n] += shift;
             self.nodes[n + 1] += shift;
         }
-        if c.ends.end != EndKind::Clamped {
-        } else if c.end.orientation == old.end.orientation {
-            let shift = c.end_point() - old.end_point();
-            self.nodes[n] += shift;
-            self.nodes[n + 1] += shift;
-        } else {
-            (self.nodes[n], self.nodes[n + 1]) = clamp_edge(c.end_point(), c.end_tangent(), n);
+        if c.ends.end == EndKind::Clamped {
+            if c.end.orientation == old.end.orientation {
+                let shift = c.end_point() - old.end_point();
+                self.nodes[n] += shift;
+                self.nodes[n + 1] += shift;
+            } else {
+                (self.nodes[n], self.nodes[n + 1]) = clamp_edge(c.end_point(), c.end_tangent(), n);
+            }
         }
         if c.ends.start == EndKind::Clamped
             && (c.start.position != old.start.position
@@ -991,8 +999,7 @@ impl RodState {
         };
         // the angle of a pinned or free end is a dof: it stays
         let before = old.theta[n] - o.phi;
-        if c.ends.end != EndKind::Clamped {
-        } else {
+        if c.ends.end == EndKind::Clamped {
             self.theta[n] = c.phi
                 + if c.end.orientation == o.end.orientation {
                     before
