@@ -1395,11 +1395,6 @@ impl Parameter {
         v.for_ends(c.ends)
     }
 
-    /// Whether it moves the s = 1 clamp.
-    pub fn moves_end(&self) -> bool {
-        !self.moves_start()
-    }
-
     /// Whether it only turns a clamp (its point stays): nothing for a
     /// pinned end, whose frame is free.
     pub fn only_turns(&self) -> bool {
