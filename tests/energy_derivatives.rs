@@ -3,7 +3,7 @@
 
 use knotrod::model::energy::{RodEnergy, Terms};
 use knotrod::model::natural::NaturalStrains;
-use knotrod::model::rod::{Clamps, Law, RodModel, RodState};
+use knotrod::model::rod::{Clamps, EndKind, Ends, Law, Parameter, RodModel, RodState};
 use nalgebra::Vector3;
 
 mod common;
@@ -68,7 +68,7 @@ fn random_state_at(n: usize, seed: u64, law: Law, clamps: Clamps) -> (RodModel, 
         // strip, as these checks were made before strips had one
         model.natural_strains = Default::default();
     }
-    let map = RodEnergy::new(model.clone()).map;
+    let map = RodEnergy::with_ends(model.clone(), Terms::ALL, clamps.ends).map;
     let mut rng = Lcg(seed);
     let dq: Vec<f64> = (0..map.len())
         .map(|d| if map.is_translation(d) { 0.01 } else { 0.5 } * rng.next())
@@ -99,17 +99,22 @@ fn check(terms: Terms, seed: u64) {
 /// FD check of one law; `hessian_step` is the step of the second differences.
 fn check_law(terms: Terms, seed: u64, law: Law, hessian_step: f64) {
     let (model, state) = random_state_with(12, seed, law);
-    check_model(terms, model, state, hessian_step)
+    check_at(terms, model, &state, hessian_step);
 }
 
 /// FD check of the energy of `model` at `state`.
 fn check_model(terms: Terms, model: RodModel, state: RodState, hessian_step: f64) {
-    let energy = RodEnergy::with_terms(model, terms);
+    check_at(terms, model, &state, hessian_step);
+}
+
+/// FD check of the energy of `model` at `state` (with its ends).
+fn check_at(terms: Terms, model: RodModel, state: &RodState, hessian_step: f64) {
+    let energy = RodEnergy::with_ends(model, terms, state.clamps.ends);
     let map = energy.map;
     let n = map.len();
     let mut g = vec![0.0; n];
     let mut vals = vec![0.0; energy.pattern.nnz()];
-    energy.hessian(&state, &mut g, &mut vals);
+    energy.hessian(state, &mut g, &mut vals);
     let h = energy.pattern.to_dense(&vals);
     // All differences are taken in the chart of `state` (frames transported from
     // it), the chart in which the Hessian is defined; gradients evaluated at
@@ -365,9 +370,8 @@ fn parameter_derivative_of_the_gradient_matches_finite_differences() {
 }
 
 fn parameter_derivative_of_the_gradient(law: Law, clamps: Clamps) {
-    use knotrod::model::rod::Parameter;
     let (model, state) = random_state_at(12, 5, law, clamps);
-    let energy = RodEnergy::new(model);
+    let energy = RodEnergy::with_ends(model, Terms::ALL, clamps.ends);
     let map = energy.map;
     let n = map.len();
     let parameters: &[Parameter] = if clamps.is_paper() {
@@ -375,7 +379,18 @@ fn parameter_derivative_of_the_gradient(law: Law, clamps: Clamps) {
     } else {
         &Parameter::ALL
     };
-    for &p in parameters {
+    // a pinned end feels its point only, a free one nothing (scenes refuse
+    // the others)
+    let felt = |p: &Parameter| match if p.moves_start() {
+        clamps.ends.start
+    } else {
+        clamps.ends.end
+    } {
+        EndKind::Clamped => true,
+        EndKind::Pinned => !p.only_turns(),
+        EndKind::Free => false,
+    };
+    for &p in parameters.iter().filter(|p| felt(p)) {
         let mut exact = vec![0.0; n];
         energy.gradient_parameter_derivative(&state, &p.velocity(&state), &mut exact);
         let v0 = p.value(&state.clamps);
@@ -446,4 +461,42 @@ fn parameter_derivative_of_the_constraints_matches_finite_differences() {
         let e = rel(&fd, &exact);
         assert!(e < 1e-6, "{p:?}: relative error {e:e}");
     }
+}
+
+/// The general clamps with these ends.
+fn with_ends(start: EndKind, end: EndKind) -> Clamps {
+    let mut c = general_clamps();
+    c.ends = Ends { start, end };
+    c
+}
+
+#[test]
+fn derivatives_with_pinned_and_free_ends_match_finite_differences() {
+    use EndKind::{Clamped, Free, Pinned};
+    for (start, end) in [
+        (Clamped, Free),
+        (Clamped, Pinned),
+        (Free, Clamped),
+        (Pinned, Clamped),
+    ] {
+        let clamps = with_ends(start, end);
+        let (model, state) = random_state_at(12, 3, Law::Kirchhoff, clamps);
+        // a pinned end's ghost node sits opposite its neighbour across the pin
+        let [(a, b), (c, d)] = [(0, 1), (12, 13)].map(|(i, j)| (state.nodes[i], state.nodes[j]));
+        if start == Pinned {
+            assert!((0.5 * (a + b) - clamps.start_point()).norm() < 1e-15);
+        }
+        if end == Pinned {
+            assert!((0.5 * (c + d) - clamps.end_point()).norm() < 1e-15);
+        }
+        check_at(Terms::ALL, model, &state, 2e-5);
+    }
+}
+
+#[test]
+fn parameter_derivative_with_pinned_ends_matches_finite_differences() {
+    // the pin moves and its edge translates with it; its angle stays free
+    use EndKind::{Clamped, Pinned};
+    parameter_derivative_of_the_gradient(Law::Kirchhoff, with_ends(Clamped, Pinned));
+    parameter_derivative_of_the_gradient(Law::Kirchhoff, with_ends(Pinned, Clamped));
 }

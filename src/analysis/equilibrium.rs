@@ -274,8 +274,8 @@ impl Conformation {
         previous: Option<&Equilibrium>,
     ) -> Conformation {
         let (points, arc) = state.centreline();
-        let [down, up] = state.clamps.ray_directions();
-        let start = state.clamps.start_point();
+        let [down, up] = state.ray_directions();
+        let start = state.start_point();
         // the knot type and ray distances need the rays only to leave the
         // curve's neighbourhood
         let reach = reach(&points);

@@ -216,9 +216,14 @@ fn inertia_at(
 }
 
 /// Number of negative eigenvalues of the block of H on the massless dofs, which
-/// (material angles coupling only to neighbouring angles) is tridiagonal.
+/// (material angles coupling only to neighbouring angles) is tridiagonal, or
+/// banded where a free end's massless ghost node joins them.
 fn massless_block_negatives(pattern: &SymmetricPattern, values: &[f64], mass: &[f64]) -> usize {
     let idx: Vec<usize> = (0..mass.len()).filter(|&d| mass[d] == 0.0).collect();
+    let band = massless_bandwidth(pattern, mass, &idx);
+    if band > 1 {
+        return banded_negatives(pattern, values, &idx, band);
+    }
     let mut negatives = 0;
     let mut d_prev = 0.0;
     for (k, &d) in idx.iter().enumerate() {
@@ -233,6 +238,60 @@ fn massless_block_negatives(pattern: &SymmetricPattern, values: &[f64], mass: &[
             negatives += 1;
         }
         d_prev = dk;
+    }
+    negatives
+}
+
+/// Bandwidth of the massless block in its own order (`idx`, ascending).
+fn massless_bandwidth(pattern: &SymmetricPattern, mass: &[f64], idx: &[usize]) -> usize {
+    let mut position = vec![usize::MAX; mass.len()];
+    for (k, &d) in idx.iter().enumerate() {
+        position[d] = k;
+    }
+    let (cp, ri) = (pattern.matrix.col_offsets(), pattern.matrix.row_indices());
+    let mut band = 0;
+    for (k, &d) in idx.iter().enumerate() {
+        // upper triangle: rows r <= d, so position[r] <= k
+        for &r in &ri[cp[d]..cp[d + 1]] {
+            if position[r] != usize::MAX {
+                band = band.max(k - position[r]);
+            }
+        }
+    }
+    band
+}
+
+/// Negative pivots of LDLᵀ (no pivoting) of the banded block of H on the
+/// dofs `idx`, O(len · band²).
+fn banded_negatives(
+    pattern: &SymmetricPattern,
+    values: &[f64],
+    idx: &[usize],
+    band: usize,
+) -> usize {
+    let entry = |j: usize, k: usize| pattern.slot(idx[j], idx[k]).map_or(0.0, |s| values[s]);
+    // l[k * band + (k − j − 1)] = L_kj for k − band <= j < k
+    let mut l = vec![0.0; idx.len() * band];
+    let mut d = vec![0.0; idx.len()];
+    let mut negatives = 0;
+    for k in 0..idx.len() {
+        let lo = k.saturating_sub(band);
+        for j in lo..k {
+            let mut v = entry(j, k);
+            for i in lo.max(j.saturating_sub(band))..j {
+                v -= l[k * band + (k - i - 1)] * d[i] * l[j * band + (j - i - 1)];
+            }
+            l[k * band + (k - j - 1)] = v / d[j];
+        }
+        let mut dk = entry(k, k);
+        for i in lo..k {
+            let lki = l[k * band + (k - i - 1)];
+            dk -= lki * lki * d[i];
+        }
+        if dk < 0.0 {
+            negatives += 1;
+        }
+        d[k] = dk;
     }
     negatives
 }

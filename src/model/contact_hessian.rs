@@ -44,7 +44,7 @@ impl ContactHessian {
         let contacts: Vec<Vec<usize>> = gaps.iter().map(|g| contact_nodes(g)).collect();
         let mut stencils: Vec<Vec<Option<usize>>> = (1..=n)
             .map(|i| map.vertex_stencil(i).to_vec())
-            .chain((1..n).map(|j| map.edge_stencil(j).to_vec()))
+            .chain(map.stretched_edges().map(|j| map.edge_stencil(j).to_vec()))
             .collect();
         for nodes in &contacts {
             stencils.push(nodes.iter().flat_map(|&k| node_dofs(energy, k)).collect());

@@ -12,7 +12,9 @@
 use crate::linalg::jet::{self, Jet3, Jet4, Jet8};
 use crate::linalg::sparse::{NO_SLOT, SymmetricPattern};
 use crate::model::frames::{self, Scalar, V3, lift};
-use crate::model::rod::{ClampVelocity, Clamps, DofMap, Law, RodModel, RodState, tangent};
+use crate::model::rod::{
+    ClampVelocity, Clamps, DofMap, EndKind, Ends, Law, RodModel, RodState, tangent,
+};
 use nalgebra::Vector3;
 
 /// Which energy terms to include.
@@ -427,7 +429,8 @@ pub struct RodEnergy {
     pub map: DofMap,
     /// Which terms are included.
     pub terms: Terms,
-    /// Hessian pattern: stencils are the N vertices then the N-2 free edges 1..N-1.
+    /// Hessian pattern: stencils are the N vertices then the stretched edges
+    /// (1..N-1 between two clamps, the end edges too at a pinned or free end).
     pub pattern: SymmetricPattern,
     /// Constrained laws: the penalty ρ of the augmented Lagrangian
     /// E + Σ (λ_i κ2_i + ρ/2 κ2_i²) evaluated in their place (λ from the
@@ -459,13 +462,22 @@ impl RodEnergy {
 
     /// Evaluator restricted to some energy terms.
     pub fn with_terms(model: RodModel, terms: Terms) -> Self {
-        let map = DofMap { n: model.segments };
+        Self::with_ends(model, terms, Ends::CLAMPED)
+    }
+
+    /// Evaluator for a rod with these boundary conditions (the states it
+    /// evaluates must have them: `state.clamps.ends`).
+    pub fn with_ends(model: RodModel, terms: Terms, ends: Ends) -> Self {
+        let map = DofMap {
+            n: model.segments,
+            ends,
+        };
         let n = model.segments;
-        let mut stencils: Vec<Vec<Option<usize>>> = Vec::with_capacity(2 * n);
+        let mut stencils: Vec<Vec<Option<usize>>> = Vec::with_capacity(2 * n + 2);
         for i in 1..=n {
             stencils.push(map.vertex_stencil(i).to_vec());
         }
-        for j in 1..n {
+        for j in map.stretched_edges() {
             stencils.push(map.edge_stencil(j).to_vec());
         }
         let pattern = SymmetricPattern::from_stencils(map.len(), &stencils);
@@ -531,8 +543,9 @@ impl RodEnergy {
             }
         }
         if self.terms.stretching {
-            for j in 1..n {
-                e += stretching_energy(&edge_variables(state, j), &self.model);
+            for j in self.map.stretched_edges() {
+                let w = self.map.edge_weight(j);
+                e += w * stretching_energy(&edge_variables(state, j), &self.model);
             }
         }
         if self.terms.gravity {
@@ -605,9 +618,13 @@ impl RodEnergy {
 
     /// Energy, node-variable gradient and Hessian (row-major 6×6) of the
     /// stretching of edge j.
+    /// An end edge (at a pinned or free end) counts half: see
+    /// [`DofMap::edge_weight`].
     pub fn edge_local(&self, state: &RodState, j: usize) -> (f64, [f64; 6], [f64; 36]) {
+        let w = self.map.edge_weight(j);
         let (e, g3, h3) = jet::hessian::<3, 6>(edge_variables(state, j), |v| {
-            stretching_energy(v, &self.model)
+            let e = stretching_energy(v, &self.model);
+            if w == 1.0 { e } else { e * w }
         });
         let mut g = [0.0; 6];
         let mut h = [0.0; 36];
@@ -691,8 +708,13 @@ impl RodEnergy {
         let e = state.nodes[j + 1] - state.nodes[j];
         let len = e.norm();
         // S h/2 (|e|/h - 1)²: gradient S (|e|/h - 1) e/|e| on x_{j+1}
-        let f = self.model.stretching_stiffness * (len / h - 1.0) / len;
-        let energy = 0.5 * self.model.stretching_stiffness * h * (len / h - 1.0).powi(2);
+        let mut f = self.model.stretching_stiffness * (len / h - 1.0) / len;
+        let mut energy = 0.5 * self.model.stretching_stiffness * h * (len / h - 1.0).powi(2);
+        let w = self.map.edge_weight(j);
+        if w != 1.0 {
+            f *= w;
+            energy *= w;
+        }
         (
             energy,
             [-f * e.x, -f * e.y, -f * e.z, f * e.x, f * e.y, f * e.z],
@@ -718,7 +740,7 @@ impl RodEnergy {
             }
         }
         if self.terms.stretching {
-            for j in 1..n {
+            for j in self.map.stretched_edges() {
                 let (_, gl) = self.edge_gradient(state, j);
                 g.nodes[j] += Vector3::new(gl[0], gl[1], gl[2]);
                 g.nodes[j + 1] += Vector3::new(gl[3], gl[4], gl[5]);
@@ -745,14 +767,16 @@ impl RodEnergy {
         let (mut energy, mut scale2) = (0.0, 0.0);
         if self.terms.bending || self.terms.twisting {
             for i in 1..=n {
-                let (e, gl) = self.vertex_gradient(state, i, model);
+                let (e, mut gl) = self.vertex_gradient(state, i, model);
+                self.fold_pinned(&[i - 1, i, i + 1], &mut gl, None);
                 energy += e;
                 scale2 += scatter(&self.map.vertex_stencil(i), &gl, grad);
             }
         }
         if self.terms.stretching {
-            for j in 1..n {
-                let (e, gl) = self.edge_gradient(state, j);
+            for j in self.map.stretched_edges() {
+                let (e, mut gl) = self.edge_gradient(state, j);
+                self.fold_pinned(&[j, j + 1], &mut gl, None);
                 energy += e;
                 scale2 += scatter(&self.map.edge_stencil(j), &gl, grad);
             }
@@ -783,19 +807,21 @@ impl RodEnergy {
                 .with_min_len(16)
                 .map(|i| self.vertex_local_with(state, i, &model))
                 .collect();
-            for (k, (e, gl, hl)) in local.iter().enumerate() {
+            for (k, (e, mut gl, mut hl)) in local.into_iter().enumerate() {
                 let i = k + 1;
+                self.fold_pinned(&[i - 1, i, i + 1], &mut gl, Some(&mut hl));
                 energy += e;
-                scale2 += scatter(&self.map.vertex_stencil(i), gl, grad);
-                scatter_hessian(&self.pattern.slots[i - 1], 11, hl, values);
+                scale2 += scatter(&self.map.vertex_stencil(i), &gl, grad);
+                scatter_hessian(&self.pattern.slots[i - 1], 11, &hl, values);
             }
         }
         if self.terms.stretching {
-            for j in 1..n {
-                let (e, gl, hl) = self.edge_local(state, j);
+            for (k, j) in self.map.stretched_edges().enumerate() {
+                let (e, mut gl, mut hl) = self.edge_local(state, j);
+                self.fold_pinned(&[j, j + 1], &mut gl, Some(&mut hl));
                 energy += e;
                 scale2 += scatter(&self.map.edge_stencil(j), &gl, grad);
-                scatter_hessian(&self.pattern.slots[n + j - 1], 6, &hl, values);
+                scatter_hessian(&self.pattern.slots[n + k], 6, &hl, values);
             }
         }
         if self.terms.gravity {
@@ -805,6 +831,42 @@ impl RodEnergy {
         GradientInfo {
             energy,
             force_scale: scale2.sqrt(),
+        }
+    }
+}
+
+impl RodEnergy {
+    /// The chain rule through a pinned end's ghost node (x_g = 2p − x_k,
+    /// or with the pin moving, both nodes translating with it): in a stencil
+    /// over `nodes`, the ghost's gradient and Hessian rows and columns fold
+    /// onto x_k with a minus sign. Nothing happens between clamps or free ends.
+    pub fn fold_pinned(&self, nodes: &[usize], g: &mut [f64], h: Option<&mut [f64]>) {
+        let Some((ghost, from)) = self.map.pinned_block(nodes) else {
+            return;
+        };
+        let m = g.len();
+        let (a, b) = (3 * ghost, 3 * from);
+        for c in 0..3 {
+            g[b + c] -= g[a + c];
+            g[a + c] = 0.0;
+        }
+        if let Some(h) = h {
+            for c in 0..3 {
+                for k in 0..m {
+                    h[(b + c) * m + k] -= h[(a + c) * m + k];
+                }
+            }
+            for k in 0..m {
+                for c in 0..3 {
+                    h[k * m + b + c] -= h[k * m + a + c];
+                }
+            }
+            for c in 0..3 {
+                for k in 0..m {
+                    h[(a + c) * m + k] = 0.0;
+                    h[k * m + a + c] = 0.0;
+                }
+            }
         }
     }
 }
@@ -850,10 +912,27 @@ pub struct ClampReactions {
 
 impl RodEnergy {
     /// Internal force and moment at s = 0 from the discrete solution.
+    /// A free s = 0 end carries neither; a pinned one no moment, its force
+    /// in the end edge's material frame.
     pub fn clamp_reactions(&self, state: &RodState) -> ClampReactions {
+        let c = &state.clamps;
+        if c.ends.start == EndKind::Free {
+            let zero = Vector3::zeros();
+            return ClampReactions {
+                force: zero,
+                moment: zero,
+            };
+        }
         let g = self.full_gradient(state);
         let force = -(g.nodes[0] + g.nodes[1]);
-        let c = &state.clamps;
+        if c.ends.start == EndKind::Pinned {
+            // the pin's translation moves both nodes of the end edge
+            let [d1, d2, d3] = state.directors(0);
+            return ClampReactions {
+                force: Vector3::new(force.dot(&d1), force.dot(&d2), force.dot(&d3)),
+                moment: Vector3::zeros(),
+            };
+        }
         if c.start.is_default() {
             // a rotation ω moves clamp nodes by ω × x and turns the clamp's frame by
             // ω; about e3 that is a change of θ_0 (for ω ⟂ e3 time-parallel transport
@@ -877,12 +956,19 @@ impl RodEnergy {
     }
 
     /// Lumped mass of each free dof: the segment length for node coordinates,
-    /// zero for material angles (no rotational inertia, as in the paper).
+    /// zero for material angles (no rotational inertia, as in the paper) and
+    /// for a free end's ghost node beyond s ∈ [0, 1].
     pub fn lumped_mass(&self) -> Vec<f64> {
         let h = self.model.segment_length();
-        (0..self.map.len())
+        let mut mass: Vec<f64> = (0..self.map.len())
             .map(|d| if self.map.is_translation(d) { h } else { 0.0 })
-            .collect()
+            .collect();
+        for ghost in [0, self.model.segments + 1] {
+            if let Some(d) = self.map.node(ghost) {
+                mass[d..d + 3].iter_mut().for_each(|m| *m = 0.0);
+            }
+        }
+        mass
     }
 }
 
@@ -893,15 +979,8 @@ impl RodEnergy {
         let n = self.model.segments;
         let mut vel = [0.0; 11];
         for (k, node) in [i - 1, i, i + 1].into_iter().enumerate() {
-            let slot = match node {
-                0 => Some(0),
-                1 => Some(1),
-                _ if node == n => Some(2),
-                _ if node == n + 1 => Some(3),
-                _ => None,
-            };
-            if let Some(c) = slot {
-                vel[3 * k..3 * k + 3].copy_from_slice(velocity.nodes[c].as_slice());
+            if let Some(v) = self.node_velocity(node, velocity) {
+                vel[3 * k..3 * k + 3].copy_from_slice(v.as_slice());
             }
         }
         if i == 1 {
@@ -911,6 +990,19 @@ impl RodEnergy {
             vel[10] = velocity.theta[1];
         }
         vel
+    }
+
+    /// Velocity of node `node` if it is one of the clamps' four.
+    fn node_velocity(&self, node: usize, velocity: &ClampVelocity) -> Option<Vector3<f64>> {
+        let n = self.model.segments;
+        let slot = match node {
+            0 => Some(0),
+            1 => Some(1),
+            _ if node == n => Some(2),
+            _ if node == n + 1 => Some(3),
+            _ => None,
+        };
+        slot.map(|c| velocity.nodes[c])
     }
 
     /// The vertices whose stencils touch a moving clamp: the last two, and the
@@ -953,26 +1045,41 @@ impl RodEnergy {
             for i in self.clamp_vertices(velocity) {
                 let (_, _, hl) = self.vertex_local(state, i);
                 let vel = self.clamp_local_velocity(i, velocity);
-                for (a, d) in self.map.vertex_stencil(i).iter().enumerate() {
+                let mut r = [0.0; 11];
+                for (a, r) in r.iter_mut().enumerate() {
+                    *r = (0..11).map(|b| hl[a * 11 + b] * vel[b]).sum::<f64>();
+                }
+                self.fold_pinned(&[i - 1, i, i + 1], &mut r, None);
+                for (d, r) in self.map.vertex_stencil(i).iter().zip(r) {
                     if let Some(d) = d {
-                        out[*d] += (0..11).map(|b| hl[a * 11 + b] * vel[b]).sum::<f64>();
+                        out[*d] += r;
                     }
                 }
             }
         }
         if self.terms.stretching {
-            // the free edges next to the clamps: edge N−1 (its node N is the
-            // clamp's) and edge 1 (its node 1) when the s = 0 clamp moves
-            let [_, s1, e0, _] = velocity.nodes;
-            let first = velocity
-                .moves_start()
-                .then_some((1, [s1.x, s1.y, s1.z, 0.0, 0.0, 0.0]));
-            let last = Some((n - 1, [0.0, 0.0, 0.0, e0.x, e0.y, e0.z]));
-            for (j, vel) in first.into_iter().chain(last) {
+            // the stretched edges next to the clamps: edge N−1 (its node N
+            // is the clamp's) and edge 1 (its node 1) when the s = 0 clamp
+            // moves; the end edges themselves at a pinned end
+            let edges = self.map.stretched_edges();
+            let first = [0, 1].into_iter().filter(|_| velocity.moves_start());
+            let last = [n - 1, n].into_iter();
+            for j in first.chain(last).filter(|j| edges.contains(j)) {
+                let mut vel = [0.0; 6];
+                for (k, node) in [j, j + 1].into_iter().enumerate() {
+                    if let Some(v) = self.node_velocity(node, velocity) {
+                        vel[3 * k..3 * k + 3].copy_from_slice(v.as_slice());
+                    }
+                }
                 let (_, _, hl) = self.edge_local(state, j);
-                for (a, d) in self.map.edge_stencil(j).iter().enumerate() {
+                let mut r = [0.0; 6];
+                for (a, r) in r.iter_mut().enumerate() {
+                    *r = (0..6).map(|b| hl[a * 6 + b] * vel[b]).sum::<f64>();
+                }
+                self.fold_pinned(&[j, j + 1], &mut r, None);
+                for (d, r) in self.map.edge_stencil(j).iter().zip(r) {
                     if let Some(d) = d {
-                        out[*d] += (0..6).map(|b| hl[a * 6 + b] * vel[b]).sum::<f64>();
+                        out[*d] += r;
                     }
                 }
             }

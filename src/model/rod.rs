@@ -4,8 +4,13 @@
 //! s = (i - 1/2) h, edges e_j = x_{j+1} - x_j centred at s = j h. Edge 0 and edge
 //! N are the clamps: each is centred on its end point, half outside the rod, so
 //! that the N interior vertices (1..=N, curvature and twist) sample [0, 1] by the
-//! midpoint rule and the scheme stays second order. Fixed: nodes 0, 1, N, N+1
-//! and the material angles of edges 0 and N.
+//! midpoint rule and the scheme stays second order. Fixed between two clamps:
+//! nodes 0, 1, N, N+1 and the material angles of edges 0 and N. A pinned end
+//! keeps its edge's midpoint at the pin (the node beyond the end placed
+//! opposite its neighbour) with its angle free; a free end fixes nothing, the
+//! ghost half of its edge beyond s ∈ [0, 1] carrying no weight. Either way
+//! the discrete moment at the last vertex is the continuum's at h/2 from the
+//! end, which the natural condition m = 0 makes O(h²).
 
 use crate::geometry::walls::wall_clearance;
 use crate::model::frames::{self, V3};
@@ -34,6 +39,30 @@ impl ClampVelocity {
             nodes: [z, z, end, end],
             theta: [0.0, theta],
         }
+    }
+
+    /// The velocity of the dofs that stay fixed at these ends: a pinned end's
+    /// edge translates with its pin point (the free dof is the node's offset
+    /// from the pin, so the edge's midpoint velocity moves both nodes and the
+    /// angle is free); a free end's nodes and angle are all free dofs.
+    pub fn for_ends(mut self, ends: Ends) -> Self {
+        for (kind, [a, b], k) in [(ends.start, [0, 1], 0), (ends.end, [2, 3], 1)] {
+            match kind {
+                EndKind::Clamped => {}
+                EndKind::Pinned => {
+                    let v = 0.5 * (self.nodes[a] + self.nodes[b]);
+                    self.nodes[a] = v;
+                    self.nodes[b] = v;
+                    self.theta[k] = 0.0;
+                }
+                EndKind::Free => {
+                    self.nodes[a] = Vector3::zeros();
+                    self.nodes[b] = Vector3::zeros();
+                    self.theta[k] = 0.0;
+                }
+            }
+        }
+        self
     }
 
     /// Whether the s = 0 clamp moves (its stencils then enter ∂p∇E).
@@ -142,6 +171,58 @@ impl RodModel {
     /// Stretching stiffness of a solid circular rod of the given diameter: 16/d².
     pub fn circular_stretching_stiffness(diameter: f64) -> f64 {
         16.0 / (diameter * diameter)
+    }
+}
+
+/// Boundary condition at one end of the rod.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq, Eq, Hash)]
+#[serde(rename_all = "snake_case")]
+pub enum EndKind {
+    /// Position and material frame fixed: a clamp.
+    #[default]
+    Clamped,
+    /// Position fixed, frame free to rotate (a ball joint): the end edge
+    /// turns about its midpoint, the pin point, and its angle is free.
+    Pinned,
+    /// Nothing fixed: the end edge's nodes and angle are free.
+    Free,
+}
+
+impl EndKind {
+    /// Whether it is a clamp.
+    pub fn is_clamped(&self) -> bool {
+        *self == EndKind::Clamped
+    }
+
+    /// Name as in scenes.
+    pub fn name(&self) -> &'static str {
+        match self {
+            EndKind::Clamped => "clamped",
+            EndKind::Pinned => "pinned",
+            EndKind::Free => "free",
+        }
+    }
+}
+
+/// The boundary conditions at s = 0 and s = 1.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq, Eq, Hash)]
+pub struct Ends {
+    /// At s = 0.
+    pub start: EndKind,
+    /// At s = 1.
+    pub end: EndKind,
+}
+
+impl Ends {
+    /// Both ends clamped (the paper's problem).
+    pub const CLAMPED: Ends = Ends {
+        start: EndKind::Clamped,
+        end: EndKind::Clamped,
+    };
+
+    /// Whether both ends are clamped.
+    pub fn both_clamped(&self) -> bool {
+        *self == Ends::CLAMPED
     }
 }
 
@@ -338,6 +419,10 @@ pub struct Clamps {
     /// Model scalars this state sets (a branch in K3 or in the weight).
     #[serde(default, skip_serializing_if = "ModelScalars::is_unset")]
     pub scalars: ModelScalars,
+    /// Boundary conditions (default: both clamped). A pinned end keeps only
+    /// its clamp's point; a free end keeps nothing of its clamp.
+    #[serde(default, skip_serializing_if = "Ends::both_clamped")]
+    pub ends: Ends,
 }
 
 impl Clamps {
@@ -350,6 +435,7 @@ impl Clamps {
             end: EndPlacement::default(),
             start: StartClamp::default(),
             scalars: ModelScalars::default(),
+            ends: Ends::CLAMPED,
         }
     }
 
@@ -361,7 +447,7 @@ impl Clamps {
     /// Whether both clamps are the paper's (e3-aligned, s = 0 at the origin):
     /// the walls, the rays along ∓e3 and Lk − φ/2π ∈ ℤ hold as in the paper.
     pub fn is_paper(&self) -> bool {
-        self.end.is_default() && self.start.is_default()
+        self.end.is_default() && self.start.is_default() && self.ends.both_clamped()
     }
 
     /// End point r(1) = (x − δ cos φ/2, y − δ sin φ/2, z*) (eq. 2.13 with no shift).
@@ -453,7 +539,15 @@ impl Clamps {
     /// The cubic from r(0) along t(0) to r(1) along t(1) (tangents scaled by
     /// the distance of the clamps): a start shape for general clamps, straight
     /// when both tangents lie along the chord.
+    /// With a free end the rod leaves its other end straight along that
+    /// end's tangent (both free: from r(0) along t(0)).
     pub fn hermite(&self, s: f64) -> Vector3<f64> {
+        if self.ends.end == EndKind::Free {
+            return self.start_point() + self.start_tangent() * s;
+        }
+        if self.ends.start == EndKind::Free {
+            return self.end_point() - self.end_tangent() * (1.0 - s);
+        }
         let (p0, p1) = (self.start_point(), self.end_point());
         let l = (p1 - p0).norm().max(1e-3);
         let (s2, s3) = (s * s, s * s * s);
@@ -484,7 +578,9 @@ impl Clamps {
     /// so that the ray closure's link less φ/2π is an integer (Lk = Tw + Wr
     /// = n + φ/2π) and can be carried along a branch.
     pub fn rays_parallel(&self) -> bool {
-        self.start.is_default() && self.end.orientation.is_identity()
+        // a pinned or free end turns: its ray follows the rod, so the link
+        // of the closure is not tied to φ
+        self.start.is_default() && self.end.orientation.is_identity() && self.ends.both_clamped()
     }
 
     /// Directions of the rays that close the rod: −t(0) from r(0), +t(1) from r(1).
@@ -542,7 +638,7 @@ impl Clamps {
             v.theta[0] = target.start.turn - self.start.turn
                 + rigid_turn(&self.start.orientation, &target.start.orientation);
         }
-        v
+        v.for_ends(self.ends)
     }
 }
 
@@ -566,17 +662,95 @@ fn rigid_turn(a: &Orientation, b: &Orientation) -> f64 {
 }
 
 /// Index map between the rod's nodes/angles and the free degrees of freedom.
-/// Free dofs are interleaved (θ_j, x_{j+1}) so that the Hessian is banded.
+/// Free dofs are interleaved (θ_j, x_{j+1}) so that the Hessian is banded:
+/// θ_j at a + 4j and x_i at a + 4i − 3, the offset a set by the s = 0 end
+/// (−4 clamped: θ_1 first; 0 pinned: θ_0 first; 3 free: x_0 first). A
+/// clamped end fixes nodes 0, 1 (N, N+1) and θ_0 (θ_N); a pinned one fixes
+/// only the ghost node 0 (N+1), placed opposite its neighbour across the pin
+/// (whose dof is then its offset from the pin point); a free one nothing.
 #[derive(Clone, Copy, Debug)]
 pub struct DofMap {
     /// Number of segments N.
     pub n: usize,
+    /// Boundary conditions.
+    pub ends: Ends,
 }
 
 impl DofMap {
-    /// Number of free degrees of freedom: 3(N-2) positions + (N-1) angles.
+    /// The map of a clamped-clamped rod of N segments.
+    pub fn clamped(n: usize) -> Self {
+        DofMap {
+            n,
+            ends: Ends::CLAMPED,
+        }
+    }
+
+    /// Offset a of the interleaved numbering.
+    fn offset(&self) -> isize {
+        match self.ends.start {
+            EndKind::Clamped => -4,
+            EndKind::Pinned => 0,
+            EndKind::Free => 3,
+        }
+    }
+
+    /// Free nodes, in dof order (3(N−2) + … coordinates).
+    pub fn free_nodes(&self) -> std::ops::RangeInclusive<usize> {
+        let lo = match self.ends.start {
+            EndKind::Clamped => 2,
+            EndKind::Pinned => 1,
+            EndKind::Free => 0,
+        };
+        let hi = match self.ends.end {
+            EndKind::Clamped => self.n - 1,
+            EndKind::Pinned => self.n,
+            EndKind::Free => self.n + 1,
+        };
+        lo..=hi
+    }
+
+    /// Edges whose material angle is free.
+    pub fn free_angles(&self) -> std::ops::RangeInclusive<usize> {
+        let lo = usize::from(self.ends.start == EndKind::Clamped);
+        let hi = self.n - usize::from(self.ends.end == EndKind::Clamped);
+        lo..=hi
+    }
+
+    /// Edges with stretching energy: those of free length (all but the
+    /// clamps, of length h).
+    pub fn stretched_edges(&self) -> std::ops::RangeInclusive<usize> {
+        let lo = usize::from(self.ends.start == EndKind::Clamped);
+        let hi = self.n - usize::from(self.ends.end == EndKind::Clamped);
+        lo..=hi
+    }
+
+    /// Weight of edge j in the midpoint rule over s ∈ [0, 1]: an end edge
+    /// is half outside the rod.
+    pub fn edge_weight(&self, j: usize) -> f64 {
+        if j == 0 || j == self.n { 0.5 } else { 1.0 }
+    }
+
+    /// The node a pinned end's ghost node is placed from (x_0 = 2 r(0) − x_1,
+    /// x_{N+1} = 2 r(1) − x_N), if node i is one.
+    pub fn dependent(&self, i: usize) -> Option<usize> {
+        if i == 0 && self.ends.start == EndKind::Pinned {
+            Some(1)
+        } else if i == self.n + 1 && self.ends.end == EndKind::Pinned {
+            Some(self.n)
+        } else {
+            None
+        }
+    }
+
+    /// Number of free degrees of freedom: 3(N-2) positions + (N-1) angles
+    /// between two clamps, more at pinned or free ends.
     pub fn len(&self) -> usize {
-        4 * self.n - 7
+        let last = match self.ends.end {
+            EndKind::Clamped => 4 * self.n as isize - 3,
+            EndKind::Pinned => 4 * self.n as isize + 1,
+            EndKind::Free => 4 * self.n as isize + 4,
+        };
+        (self.offset() + last) as usize
     }
 
     /// Never empty (N >= 4).
@@ -586,12 +760,16 @@ impl DofMap {
 
     /// First dof of node i, if free.
     pub fn node(&self, i: usize) -> Option<usize> {
-        (2..self.n).contains(&i).then(|| 4 * (i - 2) + 1)
+        self.free_nodes()
+            .contains(&i)
+            .then(|| (self.offset() + 4 * i as isize - 3) as usize)
     }
 
     /// Dof of the material angle of edge j, if free.
     pub fn theta(&self, j: usize) -> Option<usize> {
-        (1..self.n).contains(&j).then(|| 4 * (j - 1))
+        self.free_angles()
+            .contains(&j)
+            .then(|| (self.offset() + 4 * j as isize) as usize)
     }
 
     /// Free dof indices of the vertex stencil i (x_{i-1}, x_i, x_{i+1}, θ_{i-1}, θ_i).
@@ -622,9 +800,19 @@ impl DofMap {
         out
     }
 
+    /// In a stencil over `nodes`, the (local) block of a pinned end's ghost
+    /// node and the block of the node it is placed from: its derivatives
+    /// fold onto that node with a minus sign (x_ghost = 2p − x).
+    pub fn pinned_block(&self, nodes: &[usize]) -> Option<(usize, usize)> {
+        nodes.iter().enumerate().find_map(|(k, &i)| {
+            let from = self.dependent(i)?;
+            nodes.iter().position(|&j| j == from).map(|l| (k, l))
+        })
+    }
+
     /// Whether dof `d` is a translational one (a node coordinate).
     pub fn is_translation(&self, d: usize) -> bool {
-        !d.is_multiple_of(4)
+        (d as isize - self.offset()).rem_euclid(4) != 0
     }
 }
 
@@ -705,19 +893,44 @@ impl RodState {
         let end = clamps.end_point();
         let t_end = clamps.end_tangent();
         let mut nodes: Vec<Vector3<f64>> = (0..n + 2).map(|i| r((i as f64 - 0.5) * h)).collect();
-        if clamps.start.is_default() {
-            nodes[0] = -0.5 * h * e3;
-            nodes[1] = 0.5 * h * e3;
-        } else {
-            (nodes[0], nodes[1]) = clamp_edge(clamps.start_point(), clamps.start_tangent(), n);
+        let ends = clamps.ends;
+        // a free end edge samples the curve; a pinned one turns about its
+        // pin, its ghost node placed below
+        if ends.start == EndKind::Clamped {
+            if clamps.start.is_default() {
+                nodes[0] = -0.5 * h * e3;
+                nodes[1] = 0.5 * h * e3;
+            } else {
+                (nodes[0], nodes[1]) = clamp_edge(clamps.start_point(), clamps.start_tangent(), n);
+            }
         }
-        nodes[n] = end - 0.5 * h * t_end;
-        nodes[n + 1] = end + 0.5 * h * t_end;
+        if ends.end == EndKind::Clamped {
+            nodes[n] = end - 0.5 * h * t_end;
+            nodes[n + 1] = end + 0.5 * h * t_end;
+        }
+        place_pinned(&mut nodes, &clamps);
         // space-parallel reference frames from the s = 0 clamp; zero reference
         // twist in between
         let mut reference = vec![Vector3::x(); n + 1];
         reference[0] = clamps.start.orientation.reference();
-        for j in 1..n {
+        if ends.start != EndKind::Clamped {
+            // the end edge's own frame: d1 projected on its normal plane
+            let t = tangent(&nodes, 0);
+            let mut a = d1(0.0);
+            a -= a.dot(&t) * t;
+            if a.norm() < 1e-9 {
+                // d1 along the edge: any normal will do
+                let e = if t.x.abs() < 0.9 {
+                    Vector3::x()
+                } else {
+                    Vector3::y()
+                };
+                a = e - e.dot(&t) * t;
+            }
+            reference[0] = a.normalize();
+        }
+        let free_end = usize::from(ends.end != EndKind::Clamped);
+        for j in 1..n + free_end {
             let a = transport(
                 &reference[j - 1],
                 &tangent(&nodes, j - 1),
@@ -727,11 +940,12 @@ impl RodState {
             let t = tangent(&nodes, j);
             reference[j] = (a - a.dot(&t) * t).normalize();
         }
-        reference[n] = clamps.end.orientation.reference();
         let mut reference_twist = vec![0.0; n + 1];
         let mut theta = vec![0.0; n + 1];
-        theta[0] = clamps.start.turn;
-        for j in 1..n {
+        if ends.start == EndKind::Clamped {
+            theta[0] = clamps.start.turn;
+        }
+        for j in 1..n + free_end {
             let t = tangent(&nodes, j);
             let a1 = reference[j];
             let a2 = t.cross(&a1);
@@ -739,7 +953,10 @@ impl RodState {
             let raw = d.dot(&a2).atan2(d.dot(&a1));
             theta[j] = theta[j - 1] + wrap(raw - theta[j - 1]);
         }
-        theta[n] = clamps.phi;
+        if ends.end == EndKind::Clamped {
+            reference[n] = clamps.end.orientation.reference();
+            theta[n] = clamps.phi;
+        }
         let rt = reference_twist_fresh(&nodes, &reference, n);
         let m = theta[n] - theta[n - 1] + rt;
         reference_twist[n] = rt - 2.0 * PI * (m / (2.0 * PI)).round();
@@ -791,19 +1008,23 @@ impl RodState {
     /// writing into `next` (same shape): one transport of the frames, no
     /// allocation.
     pub fn move_into(&self, map: &DofMap, dq: &[f64], clamps: Clamps, next: &mut RodState) {
-        let n = self.segments();
         next.clamps = clamps;
         next.nodes.copy_from_slice(&self.nodes);
         next.theta.copy_from_slice(&self.theta);
         next.multipliers.clone_from(&self.multipliers);
         next.move_clamp_nodes(&self.clamps);
-        for i in 2..n {
+        debug_assert_eq!(
+            map.ends, clamps.ends,
+            "dof map and clamps disagree on the ends"
+        );
+        for i in map.free_nodes() {
             let d = map.node(i).unwrap();
             next.nodes[i] += Vector3::new(dq[d], dq[d + 1], dq[d + 2]);
         }
-        for j in 1..n {
+        for j in map.free_angles() {
             next.theta[j] += dq[map.theta(j).unwrap()];
         }
+        place_pinned(&mut next.nodes, &clamps);
         next.update_frames_from(self);
         next.set_clamp_angles(self);
     }
@@ -814,14 +1035,31 @@ impl RodState {
     fn move_clamp_nodes(&mut self, old: &Clamps) {
         let n = self.segments();
         let c = self.clamps;
-        if c.end.orientation == old.end.orientation {
+        // a pinned end edge translates with its pin (its dof is the offset
+        // from the pin); a free one stays
+        if c.ends.start == EndKind::Pinned {
+            let shift = c.start_point() - old.start_point();
+            self.nodes[0] += shift;
+            self.nodes[1] += shift;
+        }
+        if c.ends.end == EndKind::Pinned {
             let shift = c.end_point() - old.end_point();
             self.nodes[n] += shift;
             self.nodes[n + 1] += shift;
-        } else {
-            (self.nodes[n], self.nodes[n + 1]) = clamp_edge(c.end_point(), c.end_tangent(), n);
         }
-        if c.start.position != old.start.position || c.start.orientation != old.start.orientation {
+        if c.ends.end == EndKind::Clamped {
+            if c.end.orientation == old.end.orientation {
+                let shift = c.end_point() - old.end_point();
+                self.nodes[n] += shift;
+                self.nodes[n + 1] += shift;
+            } else {
+                (self.nodes[n], self.nodes[n + 1]) = clamp_edge(c.end_point(), c.end_tangent(), n);
+            }
+        }
+        if c.ends.start == EndKind::Clamped
+            && (c.start.position != old.start.position
+                || c.start.orientation != old.start.orientation)
+        {
             (self.nodes[0], self.nodes[1]) = clamp_edge(c.start_point(), c.start_tangent(), n);
         }
     }
@@ -843,14 +1081,20 @@ impl RodState {
             );
             previous + wrap(raw - previous)
         };
+        // the angle of a pinned or free end is a dof: it stays
         let before = old.theta[n] - o.phi;
-        self.theta[n] = c.phi
-            + if c.end.orientation == o.end.orientation {
-                before
-            } else {
-                offset(self, n, &c.end.orientation, before)
-            };
+        if c.ends.end == EndKind::Clamped {
+            self.theta[n] = c.phi
+                + if c.end.orientation == o.end.orientation {
+                    before
+                } else {
+                    offset(self, n, &c.end.orientation, before)
+                };
+        }
         let before = old.theta[0] - o.start.turn;
+        if c.ends.start != EndKind::Clamped {
+            return;
+        }
         self.theta[0] = c.start.turn
             + if c.start.orientation == o.start.orientation {
                 before
@@ -920,10 +1164,10 @@ impl RodState {
     fn heights(&self) -> Vec<f64> {
         let n = self.segments();
         let interior = &self.nodes[1..=n];
-        if self.clamps.start.is_default() {
+        if self.clamps.start.is_default() && self.clamps.ends.start == EndKind::Clamped {
             return interior.iter().map(|p| p.z).collect();
         }
-        let (r0, t0) = (self.clamps.start_point(), self.clamps.start_tangent());
+        let (r0, t0) = (self.start_point(), self.start_axis());
         interior.iter().map(|p| (p - r0).dot(&t0)).collect()
     }
 
@@ -931,7 +1175,7 @@ impl RodState {
     /// at the s = 1 clamp's height (z = 0 and z = z* for the paper's clamps;
     /// negative: outside; see [`wall_clearance`]).
     pub fn wall_clearance(&self) -> f64 {
-        wall_clearance(&self.heights(), self.clamps.top_wall())
+        wall_clearance(&self.heights(), self.top_wall())
     }
 
     /// Interior node heights: (min, max) over nodes 1..=N (s in (0,1)).
@@ -946,7 +1190,7 @@ impl RodState {
     /// Walled: every interior node strictly between the walls.
     pub fn walled(&self) -> bool {
         let (lo, hi) = self.z_range();
-        lo > 0.0 && hi < self.clamps.top_wall()
+        lo > 0.0 && hi < self.top_wall()
     }
 
     /// Move the s = 1 clamp to new parameters: the two clamp nodes translate, the
@@ -957,6 +1201,7 @@ impl RodState {
         let mut old = self.clone();
         self.clamps = clamps;
         self.move_clamp_nodes(&before);
+        place_pinned(&mut self.nodes, &clamps);
         if clamps.end.orientation == before.end.orientation {
             // a translated clamp: the frames are transported from the moved
             // nodes, i.e. only the clamp edge's neighbours feel the move
@@ -965,6 +1210,18 @@ impl RodState {
         }
         self.update_frames_from(&old);
         self.set_clamp_angles(&old);
+    }
+}
+
+/// Place a pinned end's ghost node opposite its neighbour across the pin:
+/// x_0 = 2 r(0) − x_1, x_{N+1} = 2 r(1) − x_N.
+fn place_pinned(nodes: &mut [Vector3<f64>], clamps: &Clamps) {
+    let n = nodes.len() - 2;
+    if clamps.ends.start == EndKind::Pinned {
+        nodes[0] = 2.0 * clamps.start_point() - nodes[1];
+    }
+    if clamps.ends.end == EndKind::Pinned {
+        nodes[n + 1] = 2.0 * clamps.end_point() - nodes[n];
     }
 }
 
@@ -992,15 +1249,65 @@ impl RodState {
         let h = 1.0 / n as f64;
         let mut points = Vec::with_capacity(n + 2);
         let mut arc = Vec::with_capacity(n + 2);
-        points.push(self.clamps.start_point());
+        points.push(self.start_point());
         arc.push(0.0);
         for i in 1..=n {
             points.push(self.nodes[i]);
             arc.push((i as f64 - 0.5) * h);
         }
-        points.push(self.clamps.end_point());
+        points.push(self.end_point());
         arc.push(1.0);
         (points, arc)
+    }
+
+    /// The rod's end r(0): the clamp's or pin's point, or the midpoint of a
+    /// free end edge.
+    pub fn start_point(&self) -> Vector3<f64> {
+        match self.clamps.ends.start {
+            EndKind::Free => 0.5 * (self.nodes[0] + self.nodes[1]),
+            _ => self.clamps.start_point(),
+        }
+    }
+
+    /// The rod's end r(1) (as [`Self::start_point`]).
+    pub fn end_point(&self) -> Vector3<f64> {
+        let n = self.segments();
+        match self.clamps.ends.end {
+            EndKind::Free => 0.5 * (self.nodes[n] + self.nodes[n + 1]),
+            _ => self.clamps.end_point(),
+        }
+    }
+
+    /// Tangent at s = 0: the clamp's, or the end edge's where it turns.
+    fn start_axis(&self) -> Vector3<f64> {
+        match self.clamps.ends.start {
+            EndKind::Clamped => self.clamps.start_tangent(),
+            _ => tangent(&self.nodes, 0),
+        }
+    }
+
+    /// Directions of the rays that close the rod: −t(0) from r(0), +t(1)
+    /// from r(1), along the clamps or, at a pinned or free end, along the
+    /// end edge's actual tangent.
+    pub fn ray_directions(&self) -> [Vector3<f64>; 2] {
+        let n = self.segments();
+        let [mut down, mut up] = self.clamps.ray_directions();
+        if self.clamps.ends.start != EndKind::Clamped {
+            down = -tangent(&self.nodes, 0);
+        }
+        if self.clamps.ends.end != EndKind::Clamped {
+            up = tangent(&self.nodes, n);
+        }
+        [down, up]
+    }
+
+    /// Height of r(1) above r(0) along t(0): the upper wall (the clamps'
+    /// when both are clamped, else measured on the rod's actual ends).
+    pub fn top_wall(&self) -> f64 {
+        if self.clamps.ends.both_clamped() {
+            return self.clamps.top_wall();
+        }
+        (self.end_point() - self.start_point()).dot(&self.start_axis())
     }
 }
 
@@ -1162,7 +1469,7 @@ impl Parameter {
             let t = (b - a).normalize();
             (omega.cross(&(a - p)), omega.cross(&(b - p)), omega.dot(&t))
         };
-        match self {
+        let v = match self {
             Parameter::ZStar => ClampVelocity::end(Vector3::z(), 0.0),
             Parameter::Delta => {
                 ClampVelocity::end(Vector3::new(-half.cos(), -half.sin(), 0.0), 0.0)
@@ -1206,7 +1513,21 @@ impl Parameter {
             Parameter::K2 | Parameter::K3 | Parameter::Weight | Parameter::NaturalScale => {
                 ClampVelocity::default()
             }
-        }
+        };
+        v.for_ends(c.ends)
+    }
+
+    /// Whether it only turns a clamp (its point stays): nothing for a
+    /// pinned end, whose frame is free.
+    pub fn only_turns(&self) -> bool {
+        matches!(
+            self,
+            Parameter::EndTilt
+                | Parameter::EndTiltAzimuth
+                | Parameter::StartTilt
+                | Parameter::StartTiltAzimuth
+                | Parameter::StartTurn
+        )
     }
 
     /// Name as in scenes and summaries.

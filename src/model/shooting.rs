@@ -4,7 +4,7 @@
 
 use crate::model::natural::NaturalStrains;
 use crate::model::ode::{central_jacobian, hermite, rk4};
-use crate::model::rod::{Clamps, wrap};
+use crate::model::rod::{Clamps, EndKind, wrap};
 use nalgebra::{SVector, Vector3, Vector6};
 use std::f64::consts::PI;
 
@@ -155,10 +155,22 @@ impl ShootingSolution {
     }
 
     /// Mismatch of the s = 1 boundary conditions (2.10)-(2.11) for `clamps`:
-    /// r(1) - r*, d3x(1), d3y(1), and the angle of d1 minus φ (mod 2π).
+    /// r(1) - r*, d3x(1), d3y(1), and the angle of d1 minus φ (mod 2π), for a
+    /// clamped end.
+    ///
+    /// At a pinned end: r(1) − r* and m(1); at a free end: n(1) and m(1)
+    /// (the natural conditions, in material components).
     pub fn boundary_residual(&self, clamps: &Clamps) -> Vector6<f64> {
         let y = self.end();
-        end_mismatch([part(y, 0), part(y, 1), part(y, 3)], clamps)
+        let (n1, m1) = (part(y, 4), part(y, 5));
+        match clamps.ends.end {
+            EndKind::Clamped => end_mismatch([part(y, 0), part(y, 1), part(y, 3)], clamps),
+            EndKind::Pinned => {
+                let r = part(y, 0) - clamps.end_point();
+                Vector6::new(r[0], r[1], r[2], m1[0], m1[1], m1[2])
+            }
+            EndKind::Free => Vector6::new(n1[0], n1[1], n1[2], m1[0], m1[1], m1[2]),
+        }
     }
 }
 

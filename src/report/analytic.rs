@@ -1,14 +1,16 @@
-//! Classical stability results for straight clamped rods, computed with the
-//! discrete rod, to check it against closed forms: Euler buckling of a
-//! clamped-clamped rod (P = 4π² B/L²) and Greenhill's torsional buckling
-//! (M L/B = 2 x₁ with tan x₁ = x₁, i.e. 2.8606 π).
+//! Classical results for straight rods, computed with the discrete rod, to
+//! check it against closed forms: Euler buckling of a clamped-clamped rod
+//! (P = 4π² B/L²), Greenhill's torsional buckling (M L/B = 2 x₁ with
+//! tan x₁ = x₁, i.e. 2.8606 π), and with a free end: a cantilever's tip
+//! under its weight (w L³/8B), Greenhill's heavy column (w L³/B = 7.8373)
+//! and a naturally curved rod at rest.
 
 use crate::linalg::eigen::lowest_eigenvalues;
-use crate::model::energy::RodEnergy;
-use crate::model::rod::{Clamps, RodModel, RodState};
+use crate::model::energy::{RodEnergy, Terms};
+use crate::model::rod::{Clamps, EndKind, RodModel, RodState};
 use crate::report::error::{Result, fail};
 use crate::solve::minimizer::Minimizer;
-use crate::solve::outcome::SolverSettings;
+use crate::solve::outcome::{SolveError, SolverSettings};
 use std::f64::consts::PI;
 
 /// The straight (uniformly twisted) equilibrium for `clamps`, stable or not,
@@ -99,4 +101,120 @@ pub fn greenhill_constant() -> f64 {
         x -= (x.tan() - x) / (1.0 / x.cos().powi(2) - 1.0);
     }
     2.0 * x
+}
+
+/// The clamps of a rod standing on the origin along e3, its s = 1 end free.
+pub fn cantilever_clamps() -> Clamps {
+    let mut c = Clamps::new(1.0, 0.0, 0.0);
+    c.ends.end = EndKind::Free;
+    c
+}
+
+/// A Kirchhoff rod of N segments, bending ratio K2, stretching stiffness S,
+/// weight w g and natural strains û.
+fn free_end_minimizer(n: usize, k2: f64, s: f64, weight: [f64; 3], natural: [f64; 3]) -> Minimizer {
+    let model = RodModel {
+        weight,
+        natural_strains: natural.into(),
+        segments: n,
+        k2,
+        k3: 2.0,
+        stretching_stiffness: s,
+        law: Default::default(),
+    };
+    Minimizer::new(RodEnergy::with_ends(
+        model,
+        Terms::ALL,
+        cantilever_clamps().ends,
+    ))
+}
+
+/// Tip deflection of a cantilever (clamped at the origin along e3, free at
+/// s = 1) under a weight w across it along −e2 (bending about d1, B11 = 1):
+/// −y of r(1), whose small-load continuum value is w L³/(8 B).
+pub fn cantilever_tip_deflection(n: usize, w: f64) -> Result<f64> {
+    let mut newton = free_end_minimizer(n, 3.0, 640_000.0, [0.0, -w, 0.0], [0.0; 3]);
+    let mut st = RodState::straight(n, cantilever_clamps());
+    newton.minimize(&mut st, &SolverSettings::default())?;
+    Ok(-st.end_point().y)
+}
+
+/// Weight w L³/B at which an isotropic column clamped at the origin along
+/// e3 and free at the top first becomes unstable under its weight along −e3
+/// (bisection on the inertia of the straight equilibrium). Continuum:
+/// 7.8373, the first zero of J₋₁/₃(2/3 √(w L³/B)) (Greenhill 1881).
+pub fn heavy_column_weight(n: usize, stretching_stiffness: f64) -> Result<f64> {
+    loss_of_stability(6.0, 10.0, |w| {
+        let mut newton = free_end_minimizer(n, 1.0, stretching_stiffness, [0.0, 0.0, -w], [0.0; 3]);
+        Ok(straight_equilibrium(&mut newton, cantilever_clamps())?.1 > 0)
+    })
+}
+
+/// The rod of natural curvature û1 = π clamped at the origin along e3 and
+/// free at s = 1, relaxed from straight: its energy, |n(0)| + |m(0)|, and
+/// the largest distance of r(s) at the nodes and at s = 1 from the
+/// semicircle (0, −(1 − cos πs)/π, sin πs/π) it rests as (all zero in the
+/// continuum).
+pub fn free_semicircle(n: usize) -> Result<(f64, f64, f64)> {
+    let mut newton = free_end_minimizer(n, 2.0, 640_000.0, [0.0; 3], [PI, 0.0, 0.0]);
+    let mut st = RodState::straight(n, cantilever_clamps());
+    match newton.minimize(&mut st, &SolverSettings::default()) {
+        Ok(_) => {}
+        // at rest every force is round-off, and so is the residual relative
+        // to them: the solver stops at its floor, which is the answer here
+        Err(SolveError::RoundOff { .. }) if newton.energy.energy(&st) < 1e-12 => {}
+        Err(e) => return Err(e.into()),
+    }
+    let arc =
+        |s: f64| nalgebra::Vector3::new(0.0, -(1.0 - (PI * s).cos()) / PI, (PI * s).sin() / PI);
+    let h = 1.0 / n as f64;
+    let shape = (1..=n)
+        .map(|i| (st.nodes[i] - arc((i as f64 - 0.5) * h)).norm())
+        .fold((st.end_point() - arc(1.0)).norm(), f64::max);
+    let r = newton.energy.clamp_reactions(&st);
+    Ok((
+        newton.energy.energy(&st),
+        r.force.norm() + r.moment.norm(),
+        shape,
+    ))
+}
+
+/// The continuum heavy column's critical weight: the smallest w with a
+/// nonzero solution of θ'' + w (1 − s) θ = 0, θ(0) = 0 (clamped base),
+/// θ'(1) = 0 (free top, no moment), by RK4 and bisection on θ'(1): 7.83735,
+/// the first zero of J₋₁/₃(2/3 √w) (classically w L³/EI = 7.837).
+pub fn heavy_column_constant() -> f64 {
+    let end_slope = |w: f64| {
+        let f = |s: f64, y: [f64; 2]| [y[1], -w * (1.0 - s) * y[0]];
+        let steps = 2000;
+        let ds = 1.0 / steps as f64;
+        let mut y = [0.0, 1.0];
+        for k in 0..steps {
+            let s = k as f64 * ds;
+            let a = f(s, y);
+            let b = f(
+                s + 0.5 * ds,
+                [y[0] + 0.5 * ds * a[0], y[1] + 0.5 * ds * a[1]],
+            );
+            let c = f(
+                s + 0.5 * ds,
+                [y[0] + 0.5 * ds * b[0], y[1] + 0.5 * ds * b[1]],
+            );
+            let d = f(s + ds, [y[0] + ds * c[0], y[1] + ds * c[1]]);
+            for i in 0..2 {
+                y[i] += ds / 6.0 * (a[i] + 2.0 * b[i] + 2.0 * c[i] + d[i]);
+            }
+        }
+        y[1]
+    };
+    let (mut lo, mut hi) = (6.0, 9.0);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if end_slope(mid) > 0.0 {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    0.5 * (lo + hi)
 }

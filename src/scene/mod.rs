@@ -17,7 +17,7 @@ use crate::analysis::equilibrium::Measure;
 use crate::model::contact::ContactModel;
 use crate::model::natural::NaturalStrains;
 use crate::model::rod::{
-    Clamps, Law, ModelScalars, Orientation, Parameter, RodModel, RodState, StartClamp,
+    Clamps, EndKind, Law, ModelScalars, Orientation, Parameter, RodModel, RodState, StartClamp,
 };
 use crate::solve::continuation::ContinuationSettings;
 use crate::solve::outcome::SolverSettings;
@@ -187,6 +187,11 @@ pub struct ClampSpec {
     /// The s = 0 clamp (default: the identity frame at the origin).
     #[serde(default)]
     pub start: Option<StartClampSpec>,
+    /// Boundary condition at s = 1: "clamped" (default), "pinned" (the
+    /// point r* fixed, the frame free: a ball joint) or "free" (z*, δ, φ and
+    /// the end's placement then unused).
+    #[serde(default, skip_serializing_if = "EndKind::is_clamped")]
+    pub end: EndKind,
 }
 
 /// `[clamps.start]`: the s = 0 clamp's frame.
@@ -204,6 +209,9 @@ pub struct StartClampSpec {
     pub tilt_azimuth: f64,
     /// Turn of the material frame about the tangent, in turns.
     pub turn_over_2pi: f64,
+    /// Boundary condition at s = 0: "clamped" (default), "pinned" or "free".
+    #[serde(skip_serializing_if = "EndKind::is_clamped")]
+    pub kind: EndKind,
 }
 
 /// A clamp's rotation: a unit quaternion (w, x, y, z), an axis and an angle
@@ -866,7 +874,9 @@ impl Scene {
                 },
                 turn: 2.0 * std::f64::consts::PI * st.turn_over_2pi,
             };
+            clamps.ends.start = st.kind;
         }
+        clamps.ends.end = c.end;
         clamps
     }
 }

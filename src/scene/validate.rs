@@ -1,6 +1,6 @@
 //! Scene validation: every value's range checked, the error naming the field.
 
-use crate::model::rod::{Clamps, Parameter};
+use crate::model::rod::{Clamps, EndKind, Parameter};
 use crate::scene::InitialShape;
 use crate::scene::{Scene, SceneError, finite, invalid, positive};
 
@@ -25,6 +25,127 @@ impl Scene {
         self.check_budget_spec()?;
         self.check_load()?;
         self.check_varied()?;
+        self.check_ends()?;
+        Ok(())
+    }
+
+    /// `[clamps] end` and `[clamps.start] kind`: a pinned or free end where
+    /// the solver has an isolated equilibrium to find, and nothing asked of
+    /// it that only a clamp can do.
+    fn check_ends(&self) -> Result<(), SceneError> {
+        use crate::scene::ModelKind;
+        use EndKind::{Clamped, Free, Pinned};
+        let ends = self.clamps().ends;
+        if ends.both_clamped() {
+            return Ok(());
+        }
+        if ends.start != Clamped && ends.end != Clamped {
+            let why = match (ends.start, ends.end) {
+                (Free, Free) if self.load.weight == 0.0 => {
+                    "both ends free and no weight: rigid motions are unresisted, every placement \
+                     is an equilibrium; clamp one end"
+                }
+                (Free, Free) => {
+                    "both ends free: nothing holds the weight, there is no equilibrium; clamp one end"
+                }
+                (Pinned, Pinned) => {
+                    "both ends pinned: the turn about the line through the two pins (and, for a \
+                     straight rod, a uniform spin of the material frame) is unresisted, so the \
+                     equilibria are not isolated; clamp one end"
+                }
+                _ => {
+                    "a pinned end and a free one: the rod turns freely about the pin (about the \
+                     weight's line through it under a weight), so the equilibria are not \
+                     isolated; clamp one end"
+                }
+            };
+            return Err(invalid("clamps.end", why));
+        }
+        if self.model.kind != ModelKind::Kirchhoff {
+            return Err(invalid(
+                "model.kind",
+                format!(
+                    "a {} end needs kind = \"kirchhoff\" for now: with u2 = 0 enforced, the \
+                     natural condition m(1) = 0 at the end vertex asks also m2 = 0 of the \
+                     constraint's multiplier, which makes the KKT system singular there",
+                    if ends.start == Clamped {
+                        ends.end.name()
+                    } else {
+                        ends.start.name()
+                    }
+                ),
+            ));
+        }
+        if self.contact.is_some() {
+            return Err(invalid(
+                "contact",
+                "contact needs both ends clamped for now (the rays continue the clamps, and a \
+                 pinned end's ghost node is not in the contact rows)",
+            ));
+        }
+        if ends.start != Clamped && self.initial.shape == InitialShape::Shooting {
+            return Err(invalid(
+                "initial.shape",
+                "shooting integrates from the s = 0 clamp's frame: it needs a clamped s = 0 end",
+            ));
+        }
+        // a parameter must move something the rod feels
+        let check = |field: &'static str, p: Parameter| {
+            if p.is_model() {
+                // the model's scalars move no end
+                return Ok(());
+            }
+            let kind = if p.moves_start() {
+                ends.start
+            } else {
+                ends.end
+            };
+            let side = if p.moves_start() { "s = 0" } else { "s = 1" };
+            match kind {
+                Free => Err(invalid(
+                    field,
+                    format!(
+                        "{} moves the {side} end, which is free: nothing holds it there",
+                        p.name()
+                    ),
+                )),
+                Pinned if p.only_turns() => Err(invalid(
+                    field,
+                    format!(
+                        "{} only turns the {side} end, which is pinned: its frame is free, \
+                         so the rod does not feel it",
+                        p.name()
+                    ),
+                )),
+                _ => Ok(()),
+            }
+        };
+        if let Some(c) = &self.continuation {
+            check("continuation.parameter", c.parameter)?;
+        }
+        if let Some(sw) = &self.sweep {
+            check("sweep.parameter", sw.parameter)?;
+        }
+        if let Some(m) = &self.map {
+            check("map.parameter", m.parameter)?;
+            if let Some(sl) = &m.slices {
+                check("map.slices.parameter", sl.parameter)?;
+            }
+        }
+        for l in &self.loading {
+            for (p, v) in [
+                (Parameter::ZStar, l.z_star),
+                (Parameter::Delta, l.delta),
+                (Parameter::Phi, l.phi_over_2pi),
+            ] {
+                if v.is_some() {
+                    check("loading", p)?;
+                }
+            }
+            for p in l.targets.keys() {
+                check("loading.targets", *p)?;
+            }
+        }
         Ok(())
     }
 
@@ -197,13 +318,13 @@ impl Scene {
         if general && self.initial.shape == InitialShape::DoubleRing {
             return Err(invalid(
                 "initial.shape",
-                "the double ring is unfolded to the paper's clamps only (no shift, tilt, rotation or [clamps.start])",
+                "the double ring is unfolded to the paper's clamps only (no shift, tilt, rotation, [clamps.start] or pinned/free end)",
             ));
         }
         if general && self.initial.shape == InitialShape::Trefoil {
             return Err(invalid(
                 "initial.shape",
-                "the trefoil start is tied around the paper's clamps only (no shift, tilt, rotation or [clamps.start])",
+                "the trefoil start is tied around the paper's clamps only (no shift, tilt, rotation, [clamps.start] or pinned/free end)",
             ));
         }
         reachable(["clamps.z_star", "clamps.delta"], &self.clamps())
@@ -672,14 +793,16 @@ impl Scene {
 /// |z*| ≤ 1 and sqrt(z*² + δ²) ≤ 1; `fields` name z* and δ.
 fn reachable(fields: [&'static str; 2], c: &Clamps) -> Result<(), SceneError> {
     let (z_star, delta) = (c.z_star, c.delta);
+    let free = c.ends.start == EndKind::Free || c.ends.end == EndKind::Free;
     if !c.is_paper() {
         finite(fields[0], z_star)?;
         finite(fields[1], delta)?;
         if delta < 0.0 {
             return Err(invalid(fields[1], format!("δ must be >= 0, got {delta}")));
         }
+        // a free end has no point to reach
         let span = c.span();
-        if !span.is_finite() || span > 1.0 {
+        if !free && (!span.is_finite() || span > 1.0) {
             return Err(invalid(
                 fields[0],
                 format!(

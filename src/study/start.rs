@@ -3,7 +3,7 @@
 
 use crate::analysis::class::is_trefoil;
 use crate::analysis::equilibrium::{Conformation, Equilibrium, analyse};
-use crate::model::energy::RodEnergy;
+use crate::model::energy::{RodEnergy, Terms};
 use crate::model::rod::{Clamps, Law, RodModel, RodState};
 use crate::model::shooting::{ShootingSolution, refine_shooting_loaded};
 use crate::model::strip_shooting::{StripProblem, StripUnknowns};
@@ -228,7 +228,11 @@ pub fn starting_equilibrium(
     segments: Option<usize>,
 ) -> Result<(Minimizer, RodState, SolveReport)> {
     let model = scene.rod_model(segments);
-    let mut newton = Minimizer::new(RodEnergy::new(model.clone()));
+    let mut newton = Minimizer::new(RodEnergy::with_ends(
+        model.clone(),
+        Terms::ALL,
+        scene.clamps().ends,
+    ));
     newton.contact = scene.contact_model();
     if scene.initial.shape == InitialShape::DoubleRing {
         // unfold the double ring quasi-statically: straight from its own

@@ -85,7 +85,7 @@ pub fn scene_update(e: &Equilibrium, diameter: f64, stamp: Option<Timestamp>) ->
         .lines
         .push(line(2, d1, 0.3 * diameter, colour(0.95, 0.8, 0.1, 1.0)));
     let z_star = e.z_star;
-    let end = e.state.clamps.end_point();
+    let end = e.state.end_point();
     let mut clamps = entity("clamps");
     let reach = 0.3;
     for at in [nalgebra::Vector3::zeros(), end] {

@@ -1,10 +1,15 @@
 //! Analytic cases: a straight rod under uniform twist, Euler buckling and
-//! torsional (Greenhill) buckling, against their continuum values.
+//! torsional (Greenhill) buckling, and with a free end a cantilever under
+//! its weight, Greenhill's heavy column and a naturally curved rod at rest,
+//! against their continuum values.
 
 use super::format::order;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::{Clamps, RodModel, RodState};
-use crate::report::analytic::{euler_buckling_load, greenhill_constant, greenhill_twisting_moment};
+use crate::report::analytic::{
+    cantilever_tip_deflection, euler_buckling_load, free_semicircle, greenhill_constant,
+    greenhill_twisting_moment, heavy_column_constant, heavy_column_weight,
+};
 use crate::report::error::Result;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolverSettings;
@@ -18,6 +23,7 @@ pub(super) fn section() -> Result<String> {
     s += &twist_table()?;
     s += &euler_table()?;
     s += &greenhill_table()?;
+    s += &free_end_tables()?;
     Ok(s)
 }
 
@@ -102,6 +108,64 @@ fn greenhill_table() -> Result<String> {
         let p = prev.map_or(String::new(), |x| order(x, e));
         writeln!(s, "| {n} | {m:.5} | {e:.2e} | {p} |")?;
         prev = Some(e);
+    }
+    Ok(s)
+}
+
+/// A free end: the cantilever's tip under a small weight, the heavy column,
+/// the rod of natural curvature π at rest.
+fn free_end_tables() -> Result<String> {
+    let mut s = String::new();
+    let w = 1e-3;
+    // the tip error is h² to five digits: tip = (w/8)(1 − 1/N²)
+    writeln!(
+        s,
+        "\n### Cantilever under its weight (clamped at s = 0, free at s = 1; w L³/B = {w} across the rod; continuum tip deflection w L³/8B)\n"
+    )?;
+    writeln!(s, "| N | tip deflection / (w/8) | rel. error | p |")?;
+    writeln!(s, "|---|---|---|---|")?;
+    let mut prev = None;
+    for n in [25, 50, 100, 200] {
+        let tip = cantilever_tip_deflection(n, w)? / (w / 8.0);
+        let e = (tip - 1.0).abs();
+        let p = prev.map_or(String::new(), |x| order(x, e));
+        writeln!(s, "| {n} | {tip:.8} | {e:.2e} | {p} |")?;
+        prev = Some(e);
+    }
+    let exact = heavy_column_constant();
+    writeln!(
+        s,
+        "\n### Greenhill's heavy column (clamped at the base, free at the top, isotropic; continuum w L³/B = {exact:.6}, the first zero of J₋₁/₃(2/3 √(w L³/B)), classically 7.837)\n"
+    )?;
+    writeln!(
+        s,
+        "Weight at the first negative eigenvalue of the straight column, by bisection on the inertia (S = 1e8).\n"
+    )?;
+    writeln!(s, "| N | w L³/B | rel. error | p |")?;
+    writeln!(s, "|---|---|---|---|")?;
+    let mut prev = None;
+    for n in [50, 100, 200] {
+        let wc = heavy_column_weight(n, 1e8)?;
+        let e = (wc - exact).abs() / exact;
+        let p = prev.map_or(String::new(), |x| order(x, e));
+        writeln!(s, "| {n} | {wc:.5} | {e:.2e} | {p} |")?;
+        prev = Some(e);
+    }
+    writeln!(
+        s,
+        "\n### Natural curvature û1 = π, clamped at s = 0, free at s = 1 (continuum: the semicircle, zero energy and reactions)\n"
+    )?;
+    writeln!(
+        s,
+        "| N | energy | \\|n(0)\\| + \\|m(0)\\| | max distance from the semicircle | p |"
+    )?;
+    writeln!(s, "|---|---|---|---|---|")?;
+    let mut prev = None;
+    for n in [25, 50, 100] {
+        let (e, r, d) = free_semicircle(n)?;
+        let p = prev.map_or(String::new(), |x| order(x, d));
+        writeln!(s, "| {n} | {e:.1e} | {r:.1e} | {d:.2e} | {p} |")?;
+        prev = Some(d);
     }
     Ok(s)
 }

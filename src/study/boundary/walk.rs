@@ -222,7 +222,7 @@ impl Walk<'_, '_> {
         }
         let good = self.measure.good.clone();
         let trefoil = |s: &RodState| {
-            let knot = closure_knot_along(&s.centreline().0, s.clamps.ray_directions()).ok();
+            let knot = closure_knot_along(&s.centreline().0, s.ray_directions()).ok();
             good.is_knot(knot.as_ref().map(|k| k.alexander.as_slice()))
         };
         let knotted = if skip == Some(Failure::Knot) {
