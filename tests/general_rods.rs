@@ -125,16 +125,8 @@ fn against_shooting_general(scene_of: impl Fn(usize) -> String) -> (Vec<f64>, Ve
 fn tilted_and_rotated_clamps_agree_with_shooting_at_second_order() {
     // both clamps general: the s = 0 one moved and rotated by Euler angles,
     // the s = 1 one shifted, rotated by an axis and angle, tilted and turned
-    against_shooting_general(|n| {
-        format!(
-            "[model]\nsegments = {n}\nK2 = 3.0\nK3 = 2.0\nstretching_stiffness = 1e7\n\
-             [clamps]\nz_star = 0.7\ndelta = 0.0\nphi_over_2pi = 0.15\nend_shift = [0.2, -0.1]\n\
-             end_rotation = {{ axis_angle = [1.0, 1.0, 0.0, 0.3] }}\nend_tilt = 0.4\nend_tilt_azimuth = 0.7\n\
-             [clamps.start]\nposition = [0.05, 0.0, -0.1]\nrotation = {{ euler_zyx = [0.3, -0.2, 0.1] }}\n\
-             turn_over_2pi = 0.05\n\
-             [initial]\nbump = [-0.1, 0.05, 0.0]\n[solver]\ngradient_tol = 1e-12\n"
-        )
-    });
+    // (the validation report's case, so the test and the report agree)
+    against_shooting_general(knotrod::report::validation::tilted_clamps_scene);
 }
 
 #[test]

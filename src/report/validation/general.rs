@@ -33,8 +33,10 @@ fn failed(why: impl Into<String>) -> ReportError {
     ReportError::Failed(why.into())
 }
 
-/// Both clamps general, K2 = 3, K3 = 2, EA L²/B = 1e7, at N segments.
-fn tilted_scene(n: usize) -> String {
+/// The scene text of both clamps general (the s = 0 one moved, rotated by
+/// Euler angles and turned; the s = 1 one shifted, rotated by an axis and
+/// angle, tilted and turned), K2 = 3, K3 = 2, EA L²/B = 1e7, at N segments.
+pub fn tilted_clamps_scene(n: usize) -> String {
     format!(
         "[model]\nsegments = {n}\nK2 = 3.0\nK3 = 2.0\nstretching_stiffness = 1e7\n\
          [clamps]\nz_star = 0.7\ndelta = 0.0\nphi_over_2pi = 0.15\nend_shift = [0.2, -0.1]\n\
@@ -60,7 +62,7 @@ fn tilted_table() -> Result<String> {
     let runs = [50, 100, 200]
         .into_iter()
         .map(|n| {
-            let scene = Scene::parse(&tilted_scene(n))?;
+            let scene = Scene::parse(&tilted_clamps_scene(n))?;
             let eq = solve_scene(&scene, None)?;
             Ok((n, Vector3::from(eq.n0), Vector3::from(eq.m0), scene))
         })

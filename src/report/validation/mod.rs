@@ -20,7 +20,7 @@ mod runs;
 mod strip;
 
 pub use convergence::{continuum_reference, convergence_table};
-pub use general::section as general_section;
+pub use general::{section as general_section, tilted_clamps_scene};
 
 use crate::report::error::Result;
 use crate::scene::Scene;
