@@ -164,8 +164,8 @@ fn locate_on_path(
     same: &mut dyn FnMut(&mut Minimizer, &Step) -> Result<bool>,
 ) -> Result<(RodState, Clamps)> {
     let (mut lo, mut hi) = (from.clone(), to);
-    while clamp_gap(&lo.clamps, &hi) > JUMP_LOCATION {
-        let mid = midpoint(&lo.clamps, &hi);
+    while lo.clamps.gap(&hi) > JUMP_LOCATION {
+        let mid = lo.clamps.midpoint(&hi);
         let trial = move_clamps(newton, &lo, mid, settings)?;
         if same(newton, &trial)? {
             lo = trial.state;
@@ -187,15 +187,6 @@ fn link_jump(
     b: &crate::analysis::equilibrium::Equilibrium,
 ) -> f64 {
     b.link - a.link - (eq_clamps(b).phi - eq_clamps(a).phi) / (2.0 * std::f64::consts::PI)
-}
-
-/// Largest clamp-parameter difference (φ in turns).
-fn clamp_gap(a: &Clamps, b: &Clamps) -> f64 {
-    a.gap(b)
-}
-
-fn midpoint(a: &Clamps, b: &Clamps) -> Clamps {
-    a.midpoint(b)
 }
 
 /// Run the loading path from `state` (an equilibrium at its clamps): every

@@ -68,19 +68,8 @@ fn tilted_table() -> Result<String> {
         })
         .collect::<Result<Vec<_>>>()?;
     let (_, n0, m0, scene) = &runs[2];
-    let model = scene.rod_model(None);
-    let clamps = scene.clamps();
-    let weight = Vector3::from(model.weight);
-    let (ns, ms) = refine_shooting_loaded(
-        *n0,
-        *m0,
-        model.k2,
-        model.k3,
-        (weight, &model.natural_strains),
-        &clamps,
-        20_000,
-    )
-    .ok_or_else(|| failed("tilted clamps: shooting did not converge from the DER"))?;
+    let weight = Vector3::from(scene.rod_model(None).weight);
+    let (ns, ms) = polish("tilted clamps", scene, weight, *n0, *m0)?;
     writeln!(
         s,
         "Shooting: n(0) = ({:.6}, {:.6}, {:.6}), m(0) = ({:.6}, {:.6}, {:.6}) (material frame at s = 0).\n",
@@ -90,7 +79,7 @@ fn tilted_table() -> Result<String> {
     writeln!(s, "|---|---|---|")?;
     let mut prev = None;
     for (n, a, b, _) in &runs {
-        let e = ((a - ns).norm() + (b - ms).norm()) / (ns.norm() + ms.norm());
+        let e = reaction_error((*a, *b), (ns, ms));
         let p = prev.map_or(String::new(), |x| order(x, e));
         writeln!(s, "| {n} | {e:.3e} | {p} |")?;
         prev = Some(e);
@@ -313,18 +302,9 @@ fn heavy_knot_table(scenes: &Path) -> Result<String> {
         })
         .collect::<Result<Vec<_>>>()?;
     let (_, last, scene) = &runs[2];
-    let model = scene.rod_model(None);
     let weight = Vector3::new(-25.0, 0.0, 0.0);
-    let (ns, ms) = refine_shooting_loaded(
-        Vector3::from(last.n0),
-        Vector3::from(last.m0),
-        model.k2,
-        model.k3,
-        (weight, &model.natural_strains),
-        &scene.clamps(),
-        20_000,
-    )
-    .ok_or_else(|| failed("heavy knot: shooting did not converge from the DER"))?;
+    let (n0, m0) = (Vector3::from(last.n0), Vector3::from(last.m0));
+    let (ns, ms) = polish("heavy knot", scene, weight, n0, m0)?;
     writeln!(
         s,
         "Shooting: n(0) = ({:.5}, {:.5}, {:.5}), m(0) = ({:.5}, {:.5}, {:.5}).\n",
@@ -338,8 +318,7 @@ fn heavy_knot_table(scenes: &Path) -> Result<String> {
     let mut prev = None;
     for (n, e, _) in &runs {
         let w = Parameter::Weight.value(&e.state.clamps);
-        let err = ((Vector3::from(e.n0) - ns).norm() + (Vector3::from(e.m0) - ms).norm())
-            / (ns.norm() + ms.norm());
+        let err = reaction_error((Vector3::from(e.n0), Vector3::from(e.m0)), (ns, ms));
         let p = prev.map_or(String::new(), |x| order(x, err));
         writeln!(
             s,
@@ -409,4 +388,34 @@ fn strip_weight_table(scenes: &Path) -> Result<String> {
         }
     )?;
     Ok(s)
+}
+
+/// The shooting solution of `scene`'s clamps under `weight`, polished from the
+/// DER's reactions (n0, m0): the reference of a table.
+fn polish(
+    what: &str,
+    scene: &Scene,
+    weight: Vector3<f64>,
+    n0: Vector3<f64>,
+    m0: Vector3<f64>,
+) -> Result<(Vector3<f64>, Vector3<f64>)> {
+    let model = scene.rod_model(None);
+    refine_shooting_loaded(
+        n0,
+        m0,
+        model.k2,
+        model.k3,
+        (weight, &model.natural_strains),
+        &scene.clamps(),
+        20_000,
+    )
+    .ok_or_else(|| failed(format!("{what}: shooting did not converge from the DER")))
+}
+
+/// ‖Δn(0)‖ + ‖Δm(0)‖ relative to the reference's ‖n(0)‖ + ‖m(0)‖.
+fn reaction_error(
+    (n, m): (Vector3<f64>, Vector3<f64>),
+    (ns, ms): (Vector3<f64>, Vector3<f64>),
+) -> f64 {
+    ((n - ns).norm() + (m - ms).norm()) / (ns.norm() + ms.norm())
 }
