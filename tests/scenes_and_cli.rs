@@ -429,3 +429,72 @@ fn every_shipped_scene_passes_validation() {
     }
     assert!(count >= 13, "{count} scenes");
 }
+
+#[test]
+fn bad_general_clamps_and_model_parameters_name_the_field() {
+    let clamps = |extra: &str| {
+        GOOD.replace(
+            "phi_over_2pi = 0.3\n",
+            &format!("phi_over_2pi = 0.3\n{extra}\n"),
+        )
+    };
+    let branch = |p: &str, range: &str| {
+        format!("{GOOD}\n[continuation]\nparameter = \"{p}\"\nrange = {range}\n")
+    };
+    let cases = [
+        (
+            clamps("end_rotation = { quaternion = [1.0, 1.0, 0.0, 0.0] }"),
+            "clamps.end_rotation",
+        ),
+        (
+            clamps("end_rotation = { axis_angle = [0.0, 0.0, 0.0, 1.0] }"),
+            "clamps.end_rotation",
+        ),
+        (
+            clamps("end_rotation = { euler_zyx = [nan, 0.0, 0.0] }"),
+            "clamps.end_rotation",
+        ),
+        (
+            clamps("end_rotation = { quaternion = [1.0, 0.0, 0.0] }"),
+            "quaternion",
+        ),
+        (clamps("end_tilt = inf"), "clamps.end_tilt"),
+        (clamps("end_tilt_azimuth = nan"), "clamps.end_tilt_azimuth"),
+        (clamps("end_shift = [0.5, nan]"), "clamps.end_shift"),
+        // the clamps farther apart than the rod is long
+        (clamps("end_shift = [0.9, 0.0]"), "clamps.z_star"),
+        (
+            clamps("[clamps.start]\nposition = [0.0, 0.0, inf]"),
+            "clamps.start.position",
+        ),
+        (
+            clamps("[clamps.start]\nturn_over_2pi = nan"),
+            "clamps.start.turn_over_2pi",
+        ),
+        (
+            clamps("[clamps.start]\nrotation = { quaternion = [2.0, 0.0, 0.0, 0.0] }"),
+            "clamps.start.rotation",
+        ),
+        (branch("K3", "[0.0, 4.0]"), "continuation.range"),
+        (branch("weight", "[-1e9, 1.0]"), "continuation.range"),
+        (
+            branch("K2", "[1.0, 4.0]").replace("[model]\n", "[model]\nkind = \"strip\"\n"),
+            "continuation.parameter",
+        ),
+        (
+            format!("{GOOD}\n[[loading]]\ntargets = {{ end_tilt = nan }}\nsteps = 3\n"),
+            "loading.targets",
+        ),
+        (
+            format!("{GOOD}\n[[loading]]\ntargets = {{ bogus = 1.0 }}\nsteps = 3\n"),
+            "bogus",
+        ),
+    ];
+    for (text, field) in cases {
+        let msg = error_of(&text);
+        assert!(
+            msg.contains(field),
+            "error for `{field}` does not name it: {msg}"
+        );
+    }
+}
