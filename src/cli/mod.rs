@@ -7,6 +7,7 @@ mod plot;
 mod progress;
 mod reports;
 mod run;
+pub mod verify;
 
 use crate::io::export::ExportFormat;
 use anyhow::Result;
@@ -139,6 +140,10 @@ pub enum Command {
         #[arg(long)]
         allow_large: bool,
     },
+    /// Verify shooting solutions (TOML, JSON or CSV) by two independent
+    /// methods: the continuum equations integrated adaptively and polished,
+    /// and the discrete rod at N, 2N, 4N, Richardson-extrapolated.
+    Verify(verify::Args),
 }
 
 /// Run the command line.
@@ -178,6 +183,7 @@ pub fn main_with(cli: Cli) -> Result<()> {
             segments,
             allow_large,
         } => reports::convergence(&scene, &segments, allow_large),
+        Command::Verify(args) => verify::verify(args),
         Command::Knot {
             curve,
             closed,

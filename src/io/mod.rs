@@ -1,6 +1,7 @@
 //! Files: scene files, restart states, MCAP recordings (writer, reader,
 //! Foxglove geometry), JSON summaries and map files, plots, exports.
 
+pub mod convergence_plot;
 pub mod curve_file;
 pub mod error;
 pub mod export;
@@ -11,6 +12,7 @@ pub mod plot;
 pub mod recording;
 pub mod scene_file;
 pub mod summary;
+pub mod verify_file;
 
 pub use error::IoError;
 

@@ -4,6 +4,7 @@
 
 pub mod contact;
 pub mod contact_hessian;
+pub mod continuum;
 pub mod energy;
 pub mod frames;
 pub mod natural;

@@ -1530,6 +1530,15 @@ impl Parameter {
         )
     }
 
+    /// The parameter of a scene name ("phi" is φ/2π's short name).
+    pub fn named(name: &str) -> Option<Parameter> {
+        Parameter::ALL
+            .iter()
+            .chain(Parameter::MODEL.iter())
+            .copied()
+            .find(|p| p.name() == name || (name == "phi" && *p == Parameter::Phi))
+    }
+
     /// Name as in scenes and summaries.
     pub fn name(&self) -> &'static str {
         match self {

@@ -5,3 +5,4 @@ pub mod analytic;
 pub mod bench;
 pub mod error;
 pub mod validation;
+pub mod verify;

@@ -29,6 +29,9 @@ pub enum StudyError {
     /// Strip shooting (a continuum start) did not converge.
     #[error(transparent)]
     StripShooting(#[from] StripShootingError),
+    /// The continuum check (adaptive shooting) failed.
+    #[error(transparent)]
+    Continuum(#[from] crate::model::continuum::ContinuumError),
     /// The study cannot go on, and says why.
     #[error("{0}")]
     Failed(String),

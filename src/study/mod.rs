@@ -10,3 +10,4 @@ pub mod loading;
 pub mod map;
 pub mod run;
 pub mod start;
+pub mod verify;

@@ -1,0 +1,155 @@
+//! `knotrod verify FILE`: someone's shooting solutions checked by the
+//! continuum (adaptive integration, Newton polish) and the discrete rod at
+//! three resolutions; a table on the terminal, JSON and a markdown report.
+
+use super::progress::Progress;
+use crate::io::convergence_plot::{Series, convergence_plot};
+use crate::io::json::write_pretty;
+use crate::io::verify_file::read_solutions;
+use crate::model::rod::Parameter;
+use crate::report::verify::{details, markdown, summary};
+use crate::study::verify::{Quantity, SolutionCheck, VerifyOptions, verify_all};
+use anyhow::{Context, Result, bail, ensure};
+use std::io::Write;
+use std::path::PathBuf;
+
+/// The command's arguments.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The solutions (TOML `[[solution]]`, JSON `{"solution": [...]}` or
+    /// CSV, one row each).
+    pub file: PathBuf,
+    /// The base scene (model and clamps); overrides the file's `scene`.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Also find the value of this scene parameter (e.g. phi_over_2pi)
+    /// whose solution lies closest to the given unknowns.
+    #[arg(long)]
+    pub fit: Option<String>,
+    /// The three resolutions N, 2N, 4N of the discrete rod.
+    #[arg(long, value_delimiter = ',', default_value = "100,200,400")]
+    pub segments: Vec<usize>,
+    /// Stretching stiffness S of the discrete rod (the continuum is
+    /// inextensible; the model error is O(1/S), estimated from S/10).
+    #[arg(long, default_value_t = 1e7)]
+    pub stiffness: f64,
+    /// Write the results as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write a markdown report here (with a convergence plot beside it).
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Threads (default: all cores); results are the same for any count.
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+fn parameter(name: &str) -> Result<Parameter> {
+    Parameter::named(name).with_context(|| {
+        let names: Vec<&str> = Parameter::ALL
+            .iter()
+            .chain(Parameter::MODEL.iter())
+            .map(|p| p.name())
+            .collect();
+        format!(
+            "--fit {name}: not a scene parameter (one of {})",
+            names.join(", ")
+        )
+    })
+}
+
+/// Run `knotrod verify`.
+pub fn verify(a: Args) -> Result<()> {
+    let [n1, n2, n3] = a.segments[..] else {
+        bail!("--segments: give three resolutions N, 2N, 4N (e.g. 100,200,400)");
+    };
+    ensure!(
+        n1 >= 4 && n2 == 2 * n1 && n3 == 2 * n2 && n3 <= 100_000,
+        "--segments: give N, 2N, 4N with 4 ≤ N and 4N ≤ 100000 (got {n1},{n2},{n3})"
+    );
+    ensure!(
+        a.stiffness.is_finite() && a.stiffness >= 1e3,
+        "--stiffness: a finite stretching stiffness of at least 1e3 (got {})",
+        a.stiffness
+    );
+    let options = VerifyOptions {
+        segments: [n1, n2, n3],
+        fit: a.fit.as_deref().map(parameter).transpose()?,
+        stretching_stiffness: a.stiffness,
+        ..VerifyOptions::default()
+    };
+    let (base, solutions) = read_solutions(&a.file, a.scene.as_deref())?;
+    let progress = Progress::bar(solutions.len() as u64, "solutions");
+    let run = || {
+        verify_all(&base, &solutions, &options, &|c: &SolutionCheck| {
+            progress.item(format!("{}: {:?}", c.given.name, c.verdict));
+        })
+    };
+    let checks = match a.threads {
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t.max(1))
+            .build()
+            .context("--threads: the thread pool")?
+            .install(run)?,
+        None => run()?,
+    };
+    progress.finish();
+    let mut out = std::io::stdout().lock();
+    write!(out, "{}", summary(&checks))?;
+    if checks.len() <= 10 {
+        for c in &checks {
+            writeln!(out)?;
+            write!(out, "{}", details(c, &checks))?;
+        }
+    }
+    if let Some(p) = &a.json {
+        write_pretty(p, &checks)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.report {
+        let plot = p.with_extension("svg");
+        let drawn = convergence_plot(&plot, &series(&checks)).is_ok();
+        let name = plot
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
+        let text = markdown(
+            &a.file.display().to_string(),
+            &checks,
+            options.segments,
+            drawn.then_some(name.as_str()),
+        );
+        crate::io::json::create_parent(p)?;
+        std::fs::write(p, text).with_context(|| format!("writing {}", p.display()))?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// Relative distances of n(0) of each solution's discrete rod from its
+/// continuum solution, against N.
+fn series(checks: &[SolutionCheck]) -> Vec<Series> {
+    checks
+        .iter()
+        .filter_map(|c| {
+            let e = c.estimate(Quantity::Force)?;
+            let reference = e.continuum.as_ref()?;
+            let scale = reference.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let points = c
+                .der
+                .iter()
+                .zip(&e.values)
+                .map(|(d, v)| {
+                    let dist = v
+                        .iter()
+                        .zip(reference)
+                        .map(|(a, b)| (a - b).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    (d.segments as f64, dist / scale)
+                })
+                .collect();
+            Some((format!("{}: n(0)", c.given.name), points))
+        })
+        .collect()
+}

@@ -1,0 +1,481 @@
+//! Files of shooting solutions for `knotrod verify`: TOML, JSON or CSV, one
+//! solution per `[[solution]]` table, JSON object or CSV row. Each names the
+//! scene parameters it was computed at (`phi_over_2pi = 0.802`, `K3 = 2.5`,
+//! `end_tilt = 0.1`, …, set on top of the base scene), its six shooting
+//! unknowns (`n0`, `m0` for a rod; `n0`, `u1_0`, `m2_0`, `u3_0` for a strip;
+//! in CSV `n0_1 … n0_3`, `m0_1 … m0_3`), and optionally what its author claims
+//! (`stable`, `lowest_omega2`, `twist`, `link`, `walled`, `knot`, `energy`).
+//! The base scene is the file's `scene = "path"` (relative to the file) or
+//! the command line's. Numbers are kept with their printed precision: half a
+//! unit in their last digit is what rounding can explain.
+
+use crate::model::rod::{Law, Parameter};
+use crate::scene::{Scene, SceneError};
+use crate::study::verify::{Claims, Printed, Solution};
+use std::path::{Path, PathBuf};
+
+/// Largest number of solutions in one file.
+pub const MAX_SOLUTIONS: usize = 100_000;
+
+/// Why a file of solutions could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum VerifyFileError {
+    /// Reading failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML, JSON or CSV.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// The parser's message.
+        message: String,
+    },
+    /// A field of a solution is missing, unknown or bad.
+    #[error("{path}: {row}: {field}: {reason}")]
+    Field {
+        /// The file.
+        path: PathBuf,
+        /// Which solution ("solution 3", "line 4").
+        row: String,
+        /// The field.
+        field: String,
+        /// Why.
+        reason: String,
+    },
+    /// No base scene was given.
+    #[error("{path}: no scene: give `scene = \"path\"` in the file or --scene on the command line")]
+    NoScene {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Too many solutions.
+    #[error("{path}: {count} solutions; the most read is {MAX_SOLUTIONS}")]
+    TooMany {
+        /// The file.
+        path: PathBuf,
+        /// How many.
+        count: usize,
+    },
+    /// The base scene could not be read.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+}
+
+/// A value as written: numbers keep half a unit of their last digit.
+#[derive(Clone, Debug)]
+enum Raw {
+    Number(f64, f64),
+    Bool(bool),
+    Text(String),
+    List(Vec<(f64, f64)>),
+}
+
+/// Half a unit in the last digit of a decimal literal ("8.7100" → 5e-5,
+/// "-24.743" → 5e-4, "1.5e-3" → 5e-5, "12" → 0.5).
+pub fn half_unit(literal: &str) -> f64 {
+    let t = literal.trim().replace('_', "").to_ascii_lowercase();
+    let (mantissa, exponent) = match t.split_once('e') {
+        Some((m, e)) => (m.to_string(), e.parse::<i32>().unwrap_or(0)),
+        None => (t.clone(), 0),
+    };
+    let decimals = mantissa.split_once('.').map_or(0, |(_, f)| f.len() as i32);
+    0.5 * 10f64.powi(exponent - decimals)
+}
+
+fn number(text: &str) -> Option<(f64, f64)> {
+    let v: f64 = text.trim().replace('_', "").parse().ok()?;
+    Some((v, half_unit(text)))
+}
+
+type Row = (String, Vec<(String, Raw)>);
+
+fn toml_raw(v: &toml::de::DeValue) -> Option<Raw> {
+    use toml::de::DeValue;
+    Some(match v {
+        DeValue::Float(f) => {
+            let (x, u) = number(f.as_str())?;
+            Raw::Number(x, u)
+        }
+        DeValue::Integer(i) if i.radix() == 10 => {
+            let (x, u) = number(i.as_str())?;
+            Raw::Number(x, u)
+        }
+        DeValue::Boolean(b) => Raw::Bool(*b),
+        DeValue::String(s) => Raw::Text(s.to_string()),
+        DeValue::Array(a) => Raw::List(
+            a.into_iter()
+                .map(|x| match toml_raw(x.get_ref())? {
+                    Raw::Number(x, u) => Some((x, u)),
+                    _ => None,
+                })
+                .collect::<Option<Vec<_>>>()?,
+        ),
+        _ => return None,
+    })
+}
+
+fn parse_toml(path: &Path, text: &str) -> Result<(Option<String>, Vec<Row>), VerifyFileError> {
+    let parse_error = |message: String| VerifyFileError::Parse {
+        path: path.into(),
+        message,
+    };
+    let table = toml::de::DeTable::parse(text).map_err(|e| parse_error(e.to_string()))?;
+    let mut scene = None;
+    let mut rows = Vec::new();
+    for (key, value) in table.get_ref().iter() {
+        match key.get_ref().as_ref() {
+            "scene" => {
+                scene = Some(
+                    value
+                        .get_ref()
+                        .as_str()
+                        .ok_or_else(|| parse_error("scene: a path (a string)".into()))?
+                        .to_string(),
+                )
+            }
+            "solution" => {
+                let list = value.get_ref().as_array().ok_or_else(|| {
+                    parse_error("solution: an array of tables [[solution]]".into())
+                })?;
+                for (k, item) in list.into_iter().enumerate() {
+                    let row = format!("solution {}", k + 1);
+                    let table = item
+                        .get_ref()
+                        .as_table()
+                        .ok_or_else(|| parse_error(format!("{row}: a table of fields")))?;
+                    let mut fields = Vec::new();
+                    for (name, v) in table.iter() {
+                        let name = name.get_ref().to_string();
+                        let raw = toml_raw(v.get_ref()).ok_or_else(|| VerifyFileError::Field {
+                            path: path.into(),
+                            row: row.clone(),
+                            field: name.clone(),
+                            reason: "not a number, a list of numbers, a boolean or a string".into(),
+                        })?;
+                        fields.push((name, raw));
+                    }
+                    rows.push((row, fields));
+                }
+            }
+            other => {
+                return Err(parse_error(format!(
+                    "unknown key `{other}` (expected scene and [[solution]])"
+                )));
+            }
+        }
+    }
+    Ok((scene, rows))
+}
+
+fn json_raw(raw: &serde_json::value::RawValue) -> Option<Raw> {
+    let t = raw.get().trim();
+    Some(match t.chars().next()? {
+        '[' => {
+            let items: Vec<Box<serde_json::value::RawValue>> = serde_json::from_str(t).ok()?;
+            Raw::List(
+                items
+                    .iter()
+                    .map(|x| number(x.get()))
+                    .collect::<Option<Vec<_>>>()?,
+            )
+        }
+        '"' => Raw::Text(serde_json::from_str(t).ok()?),
+        't' | 'f' => Raw::Bool(serde_json::from_str(t).ok()?),
+        _ => {
+            let (x, u) = number(t)?;
+            Raw::Number(x, u)
+        }
+    })
+}
+
+fn parse_json(path: &Path, text: &str) -> Result<(Option<String>, Vec<Row>), VerifyFileError> {
+    use serde_json::value::RawValue;
+    use std::collections::BTreeMap;
+    let parse_error = |message: String| VerifyFileError::Parse {
+        path: path.into(),
+        message,
+    };
+    // each field is read as raw text, for its printed precision
+    let top: BTreeMap<String, Box<RawValue>> =
+        serde_json::from_str(text).map_err(|e| parse_error(e.to_string()))?;
+    let mut scene = None;
+    let mut list: Vec<BTreeMap<String, Box<RawValue>>> = vec![];
+    for (key, value) in &top {
+        match key.as_str() {
+            "scene" => {
+                scene = Some(
+                    serde_json::from_str::<String>(value.get())
+                        .map_err(|_| parse_error("scene: a path (a string)".into()))?,
+                )
+            }
+            "solution" => {
+                list = serde_json::from_str(value.get())
+                    .map_err(|e| parse_error(format!("solution: a list of objects ({e})")))?
+            }
+            other => {
+                return Err(parse_error(format!(
+                    "unknown key `{other}` (expected scene and solution)"
+                )));
+            }
+        }
+    }
+    let mut rows = Vec::new();
+    for (k, fields) in list.iter().enumerate() {
+        let row = format!("solution {}", k + 1);
+        let mut out = Vec::new();
+        for (name, value) in fields {
+            let raw = json_raw(value).ok_or_else(|| VerifyFileError::Field {
+                path: path.into(),
+                row: row.clone(),
+                field: name.clone(),
+                reason: "not a number, a list of numbers, a boolean or a string".into(),
+            })?;
+            out.push((name.clone(), raw));
+        }
+        rows.push((row, out));
+    }
+    Ok((scene, rows))
+}
+
+fn parse_csv(path: &Path, text: &str) -> Result<(Option<String>, Vec<Row>), VerifyFileError> {
+    let parse_error = |message: String| VerifyFileError::Parse {
+        path: path.into(),
+        message,
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = reader
+        .headers()
+        .map_err(|e| parse_error(e.to_string()))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let mut rows = Vec::new();
+    for record in reader.records() {
+        let record = record.map_err(|e| parse_error(e.to_string()))?;
+        let line = record.position().map_or(0, |p| p.line());
+        let row = format!("line {line}");
+        let mut fields = Vec::new();
+        for (name, cell) in header.iter().zip(record.iter()) {
+            if cell.is_empty() {
+                continue;
+            }
+            let raw = match cell.to_ascii_lowercase().as_str() {
+                "true" => Raw::Bool(true),
+                "false" => Raw::Bool(false),
+                _ => match number(cell) {
+                    Some((x, u)) => Raw::Number(x, u),
+                    None => Raw::Text(cell.to_string()),
+                },
+            };
+            fields.push((name.clone(), raw));
+        }
+        rows.push((row, fields));
+    }
+    Ok((None, rows))
+}
+
+/// The solutions of `path` (TOML, JSON or CSV by its extension) and their base
+/// scene (`scene` overrides the file's `scene = "…"`).
+pub fn read_solutions(
+    path: &Path,
+    scene: Option<&Path>,
+) -> Result<(Scene, Vec<Solution>), VerifyFileError> {
+    let text = crate::io::read_text(path, crate::io::SCENE_FILE_LIMIT).map_err(|source| {
+        VerifyFileError::Io {
+            path: path.into(),
+            source,
+        }
+    })?;
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let (named, rows) = match ext.as_str() {
+        "json" => parse_json(path, &text)?,
+        "csv" => parse_csv(path, &text)?,
+        _ => parse_toml(path, &text)?,
+    };
+    if rows.len() > MAX_SOLUTIONS {
+        return Err(VerifyFileError::TooMany {
+            path: path.into(),
+            count: rows.len(),
+        });
+    }
+    let scene_path = match (scene, named) {
+        (Some(p), _) => p.to_path_buf(),
+        (None, Some(p)) => path.parent().unwrap_or(Path::new(".")).join(p),
+        (None, None) => return Err(VerifyFileError::NoScene { path: path.into() }),
+    };
+    let base = Scene::load(&scene_path)?;
+    let strip = matches!(base.rod_model(None).law, Law::Strip { .. });
+    let solutions = rows
+        .into_iter()
+        .enumerate()
+        .map(|(k, (row, fields))| solution(path, k, &row, fields, strip))
+        .collect::<Result<Vec<_>, _>>()?;
+    if solutions.is_empty() {
+        return Err(VerifyFileError::Parse {
+            path: path.into(),
+            message: "no solution in the file".into(),
+        });
+    }
+    Ok((base, solutions))
+}
+
+fn solution(
+    path: &Path,
+    index: usize,
+    row: &str,
+    fields: Vec<(String, Raw)>,
+    strip: bool,
+) -> Result<Solution, VerifyFileError> {
+    let bad = |field: &str, reason: String| VerifyFileError::Field {
+        path: path.into(),
+        row: row.into(),
+        field: field.into(),
+        reason,
+    };
+    let mut name = format!("row {}", index + 1);
+    let mut parameters: Vec<(Parameter, f64)> = Vec::new();
+    let mut parameter_rounding: Vec<f64> = Vec::new();
+    let mut unknowns: [Option<(f64, f64)>; 6] = [None; 6];
+    let mut claims = Claims::default();
+    let finite = |field: &str, raw: &Raw| -> Result<(f64, f64), VerifyFileError> {
+        match raw {
+            Raw::Number(x, u) if x.is_finite() => Ok((*x, *u)),
+            _ => Err(bad(field, "a finite number".into())),
+        }
+    };
+    let printed = |field: &str, raw: &Raw| -> Result<Printed, VerifyFileError> {
+        let (value, half_unit) = finite(field, raw)?;
+        Ok(Printed { value, half_unit })
+    };
+    let flag = |field: &str, raw: &Raw| -> Result<bool, VerifyFileError> {
+        match raw {
+            Raw::Bool(b) => Ok(*b),
+            _ => Err(bad(field, "true or false".into())),
+        }
+    };
+    // the unknowns' slots: n0 then m0 (rod) or u1_0, m2_0, u3_0 (strip)
+    let slots: &[(&str, usize)] = if strip {
+        &[("u1_0", 3), ("m2_0", 4), ("u3_0", 5)]
+    } else {
+        &[]
+    };
+    for (field, raw) in &fields {
+        let f = field.as_str();
+        let mut vector = |base: usize, f: &str| -> Result<(), VerifyFileError> {
+            match raw {
+                Raw::List(v) if v.len() == 3 && v.iter().all(|x| x.0.is_finite()) => {
+                    for c in 0..3 {
+                        unknowns[base + c] = Some(v[c]);
+                    }
+                    Ok(())
+                }
+                _ => Err(bad(f, "three finite numbers [x, y, z]".into())),
+            }
+        };
+        match f {
+            "name" => match raw {
+                Raw::Text(t) => name = t.clone(),
+                Raw::Number(x, _) => name = format!("{x}"),
+                _ => return Err(bad(f, "a name".into())),
+            },
+            "n0" => vector(0, f)?,
+            "m0" if !strip => vector(3, f)?,
+            "m0" => {
+                return Err(bad(
+                    f,
+                    "the scene is a strip: give its unknowns u1_0, m2_0, u3_0 with n0".into(),
+                ));
+            }
+            "n0_1" | "n0_2" | "n0_3" => {
+                unknowns[f.as_bytes()[3] as usize - b'1' as usize] = Some(finite(f, raw)?)
+            }
+            "m0_1" | "m0_2" | "m0_3" if !strip => {
+                unknowns[3 + f.as_bytes()[3] as usize - b'1' as usize] = Some(finite(f, raw)?)
+            }
+            "u1_0" | "m2_0" | "u3_0" if !strip => {
+                return Err(bad(
+                    f,
+                    "the scene is a rod: give its unknowns n0 and m0 (material frame at s = 0)"
+                        .into(),
+                ));
+            }
+            "stable" => claims.stable = Some(flag(f, raw)?),
+            "walled" => claims.walled = Some(flag(f, raw)?),
+            "lowest_omega2" => claims.lowest_omega2 = Some(printed(f, raw)?),
+            "twist" => claims.twist = Some(printed(f, raw)?),
+            "link" => claims.link = Some(printed(f, raw)?),
+            "energy" => claims.energy = Some(printed(f, raw)?),
+            "knot" => match raw {
+                Raw::Text(t) => claims.knot = Some(t.clone()),
+                _ => return Err(bad(f, "a knot name such as \"3_1\" or \"0_1\"".into())),
+            },
+            _ => {
+                if let Some(&(_, slot)) = slots.iter().find(|(n, _)| *n == f) {
+                    unknowns[slot] = Some(finite(f, raw)?);
+                } else if let Some(p) = Parameter::named(f) {
+                    let (v, u) = finite(f, raw)?;
+                    if parameters.iter().any(|(q, _)| *q == p) {
+                        return Err(bad(f, format!("{} is given twice", p.name())));
+                    }
+                    parameters.push((p, v));
+                    parameter_rounding.push(u);
+                } else {
+                    return Err(bad(
+                        f,
+                        "unknown field (a scene parameter such as z_star, delta, phi_over_2pi, \
+                         end_tilt, K3, weight; the unknowns n0, m0 or u1_0, m2_0, u3_0; or a \
+                         claim: stable, lowest_omega2, twist, link, walled, knot, energy)"
+                            .into(),
+                    ));
+                }
+            }
+        }
+    }
+    let names: [&str; 6] = if strip {
+        ["n0_1", "n0_2", "n0_3", "u1_0", "m2_0", "u3_0"]
+    } else {
+        ["n0_1", "n0_2", "n0_3", "m0_1", "m0_2", "m0_3"]
+    };
+    let mut values = [0.0; 6];
+    let mut rounding = [0.0; 6];
+    for k in 0..6 {
+        let (v, u) = unknowns[k].ok_or_else(|| bad(names[k], "missing".into()))?;
+        values[k] = v;
+        rounding[k] = u;
+    }
+    Ok(Solution {
+        name,
+        parameters,
+        parameter_rounding,
+        unknowns: values,
+        rounding,
+        claims,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn printed_precision_is_kept() {
+        assert_eq!(half_unit("8.7100"), 5e-5);
+        assert_eq!(half_unit("-24.743"), 0.5e-3);
+        assert!((half_unit("1.5e-3") - 5e-5).abs() < 1e-20);
+        assert_eq!(half_unit("12"), 0.5);
+        assert_eq!(half_unit("1_000.25"), 5e-3);
+    }
+}

@@ -1,0 +1,494 @@
+//! The continuum equilibrium integrated to a tolerance: the Kirchhoff
+//! equations (A.2) and the strip's (A.1 with 4.3) from the six shooting
+//! unknowns at s = 0, by an adaptive eighth-order Runge–Kutta method
+//! (Dormand–Prince 8(5,3), the `ode_solvers` crate), with the energy and the
+//! weight's potential integrated alongside. This is the independent check of
+//! `knotrod verify`: it shares the equations' right-hand sides with
+//! `shooting.rs` and `strip_shooting.rs` but neither their fixed-step RK4 nor
+//! anything of the discrete rod.
+
+use crate::model::energy::strip_energy;
+use crate::model::natural::NaturalStrains;
+use crate::model::ode::central_jacobian;
+use crate::model::rod::{Clamps, EndKind, Law, RodModel};
+use crate::model::shooting::{OdeState, end_mismatch, rhs_loaded, start_frame};
+use crate::model::strip_shooting::{StripOdeState, sadowsky, strip_rhs};
+use nalgebra::{SVector, Vector3, Vector6};
+use ode_solvers::{Dop853, OutputType, System};
+use std::f64::consts::PI;
+
+/// Why a continuum solution could not be made.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ContinuumError {
+    /// The model has no continuum counterpart here.
+    #[error("the continuum check does not cover {0}")]
+    Unsupported(&'static str),
+    /// A shooting unknown is NaN or infinite.
+    #[error("shooting unknown {0} is not finite")]
+    NotFinite(usize),
+    /// The adaptive integrator stopped before s = 1.
+    #[error("the continuum equations could not be integrated past s = {s:.4}: {reason}")]
+    Integration {
+        /// Where it stopped.
+        s: f64,
+        /// The integrator's reason.
+        reason: String,
+    },
+    /// Newton did not bring the s = 1 residual below its tolerance.
+    #[error(
+        "shooting Newton did not converge in {iterations} iterations (residual {residual:.3e})"
+    )]
+    NotConverged {
+        /// Iterations made.
+        iterations: usize,
+        /// The last residual's norm.
+        residual: f64,
+    },
+    /// The Jacobian of the s = 1 conditions is singular or not finite.
+    #[error("shooting Newton: singular or non-finite Jacobian of the s = 1 conditions")]
+    Singular,
+}
+
+/// The constitutive law the continuum equations take.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ContinuumLaw {
+    /// Kirchhoff rod, unknowns n(0), m(0) in the s = 0 material frame.
+    Kirchhoff {
+        /// B22 / B11.
+        k2: f64,
+        /// B33 / B11.
+        k3: f64,
+    },
+    /// Sadowsky strip, unknowns n(0), u1(0), m2(0), u3(0) (paper Sec. 4).
+    Strip {
+        /// ε of the DER's law.
+        regularisation: f64,
+    },
+}
+
+/// One continuum boundary-value problem: the law, loads and clamps.
+#[derive(Clone, Debug)]
+pub struct Continuum {
+    /// The law.
+    pub law: ContinuumLaw,
+    /// Body force w g per unit length (lab frame).
+    pub weight: Vector3<f64>,
+    /// Natural strains û(s).
+    pub natural: NaturalStrains,
+    /// The clamps (s = 0 frame and the s = 1 conditions).
+    pub clamps: Clamps,
+    /// Relative and absolute tolerance of the adaptive integrator.
+    pub tolerance: f64,
+}
+
+/// The six shooting unknowns at s = 0: n(0), m(0) for a rod; n(0), u1(0),
+/// m2(0), u3(0) for a strip.
+pub type Unknowns = Vector6<f64>;
+
+/// A continuum solution from given unknowns.
+#[derive(Clone, Debug)]
+pub struct ContinuumSolution {
+    /// The s = 1 conditions' mismatch (r − r*, d3 off the clamp's tangent,
+    /// angle of d1; pinned: r − r*, m; free: n, m).
+    pub end_residual: Vector6<f64>,
+    /// n(0) in the s = 0 material frame.
+    pub n0: Vector3<f64>,
+    /// m(0) in the s = 0 material frame.
+    pub m0: Vector3<f64>,
+    /// Tw = (1/2π) ∫ u3 ds.
+    pub twist: f64,
+    /// Elastic energy minus the weight's work, ∫ (W − w g·r) ds.
+    pub energy: f64,
+    /// r(s) at s = k / (len − 1) (empty unless samples were asked for).
+    pub centreline: Vec<Vector3<f64>>,
+    /// Steps the integrator took.
+    pub steps: u32,
+}
+
+/// A polished solution: the unknowns Newton shooting converged to.
+#[derive(Clone, Debug)]
+pub struct Polished {
+    /// The unknowns.
+    pub unknowns: Unknowns,
+    /// The s = 1 residual's norm there.
+    pub residual: f64,
+    /// Newton iterations.
+    pub iterations: usize,
+}
+
+/// Converged when the s = 1 residual's norm is below this.
+const NEWTON_TOL: f64 = 1e-10;
+const NEWTON_ITERATIONS: usize = 40;
+
+// the rod's state (A.2) then ∫W ds and ∫ w g·r ds
+const ROD: usize = 21;
+// the strip's state then ∫W ds and ∫ w g·r ds
+const STRIP: usize = 23;
+
+struct Rhs<F>(F);
+
+impl<F, const D: usize> System<f64, ode_solvers::SVector<f64, D>> for Rhs<F>
+where
+    F: Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+{
+    fn system(
+        &self,
+        s: f64,
+        y: &ode_solvers::SVector<f64, D>,
+        dy: &mut ode_solvers::SVector<f64, D>,
+    ) {
+        // ode_solvers builds on another nalgebra: the vectors cross as slices
+        let f = (self.0)(s, &SVector::from_column_slice(y.as_slice()));
+        dy.as_mut_slice().copy_from_slice(f.as_slice());
+    }
+}
+
+/// y(1), y at the asked samples, and the steps taken.
+type Integrated<const D: usize> = (SVector<f64, D>, Vec<SVector<f64, D>>, u32);
+
+/// y(1) of y' = f(s, y) from y(0) = `y0` to `tolerance`, and y at
+/// `samples` evenly spaced s if asked (dense output of order 7).
+fn integrate<const D: usize>(
+    y0: SVector<f64, D>,
+    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+    tolerance: f64,
+    samples: usize,
+) -> Result<Integrated<D>, ContinuumError> {
+    let start = ode_solvers::SVector::<f64, D>::from_column_slice(y0.as_slice());
+    let run = |dense: bool| {
+        let dx = if dense {
+            1.0 / (samples - 1) as f64
+        } else {
+            1.0
+        };
+        let mut solver = Dop853::new(Rhs(&f), 0.0, 1.0, dx, start, tolerance, tolerance);
+        // (Dense is the crate's default; Sparse ends on the last step's y(1))
+        solver.set_output(if dense {
+            OutputType::Dense
+        } else {
+            OutputType::Sparse
+        });
+        let stats = solver
+            .integrate()
+            .map_err(|e| ContinuumError::Integration {
+                s: match e {
+                    ode_solvers::dop_shared::IntegrationError::MaxNumStepReached { x, .. }
+                    | ode_solvers::dop_shared::IntegrationError::StepSizeUnderflow { x }
+                    | ode_solvers::dop_shared::IntegrationError::StiffnessDetected { x } => x,
+                },
+                reason: e.to_string(),
+            })?;
+        let ys: Vec<SVector<f64, D>> = solver
+            .y_out()
+            .iter()
+            .map(|y| SVector::from_column_slice(y.as_slice()))
+            .collect();
+        Ok::<_, ContinuumError>((ys, stats.accepted_steps))
+    };
+    let (ys, steps) = run(false)?;
+    let end = *ys.last().ok_or(ContinuumError::Integration {
+        s: 0.0,
+        reason: "no step".into(),
+    })?;
+    if end.iter().any(|v| !v.is_finite()) {
+        return Err(ContinuumError::Integration {
+            s: 1.0,
+            reason: "the solution is not finite".into(),
+        });
+    }
+    let mut dense = if samples >= 2 { run(true)?.0 } else { vec![] };
+    // the crate's dense output at s = 1 itself is an extrapolation (errors
+    // of 1e-10 seen); the step's own y(1) is exact to the tolerance
+    if let Some(last) = dense.last_mut() {
+        *last = end;
+    }
+    if samples >= 2 && dense.len() != samples {
+        return Err(ContinuumError::Integration {
+            s: 1.0,
+            reason: format!("dense output gave {} samples, not {samples}", dense.len()),
+        });
+    }
+    Ok((end, dense, steps))
+}
+
+fn part<const D: usize>(y: &SVector<f64, D>, k: usize) -> Vector3<f64> {
+    Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
+}
+
+impl Continuum {
+    /// The continuum problem of a discrete rod model at `clamps`.
+    pub fn of(model: &RodModel, clamps: Clamps, tolerance: f64) -> Result<Self, ContinuumError> {
+        let law = match model.law {
+            Law::Kirchhoff => ContinuumLaw::Kirchhoff {
+                k2: model.k2,
+                k3: model.k3,
+            },
+            Law::Strip { regularisation } => {
+                if !clamps.start.is_default() {
+                    return Err(ContinuumError::Unsupported(
+                        "a strip with a general s = 0 clamp",
+                    ));
+                }
+                if clamps.ends.end != EndKind::Clamped {
+                    return Err(ContinuumError::Unsupported(
+                        "a strip with a pinned or free end",
+                    ));
+                }
+                ContinuumLaw::Strip { regularisation }
+            }
+            Law::Unbendable => {
+                return Err(ContinuumError::Unsupported("the unbendable rod (K2 → ∞)"));
+            }
+        };
+        if clamps.ends.start != EndKind::Clamped {
+            return Err(ContinuumError::Unsupported(
+                "a rod whose s = 0 end is not clamped (the shooting starts there)",
+            ));
+        }
+        Ok(Continuum {
+            law,
+            weight: Vector3::from(model.weight),
+            natural: model.natural_strains.clone(),
+            clamps,
+            tolerance,
+        })
+    }
+
+    /// Integrate from `p`, with r(s) at `samples` points if `samples` ≥ 2.
+    pub fn solve(&self, p: &Unknowns, samples: usize) -> Result<ContinuumSolution, ContinuumError> {
+        if let Some(k) = p.iter().position(|v| !v.is_finite()) {
+            return Err(ContinuumError::NotFinite(k));
+        }
+        let w = self.weight;
+        match self.law {
+            ContinuumLaw::Kirchhoff { k2, k3 } => {
+                let mut y0 = SVector::<f64, ROD>::zeros();
+                let frame = start_frame(&self.clamps);
+                y0.fixed_rows_mut::<19>(0).copy_from(&frame);
+                for c in 0..6 {
+                    y0[12 + c] = p[c];
+                }
+                let f = |s: f64, y: &SVector<f64, ROD>| {
+                    let core: OdeState = y.fixed_rows::<19>(0).into();
+                    let mut dy = SVector::<f64, ROD>::zeros();
+                    let natural = self.natural.vector_at(s);
+                    dy.fixed_rows_mut::<19>(0)
+                        .copy_from(&rhs_loaded(&core, k2, k3, &w, &natural));
+                    let m = part(y, 5);
+                    dy[19] = 0.5 * (m[0] * m[0] + m[1] * m[1] / k2 + m[2] * m[2] / k3);
+                    dy[20] = w.dot(&part(y, 0));
+                    dy
+                };
+                let solved = integrate(y0, f, self.tolerance, samples)?;
+                Ok(self.solution(p, p.fixed_rows::<3>(3).into(), solved, 18))
+            }
+            ContinuumLaw::Strip { regularisation } => {
+                let mut y0 = SVector::<f64, STRIP>::zeros();
+                let a0 = p[3] - self.natural.at(0.0)[0];
+                let (m13, _) = sadowsky(a0, p[5], regularisation);
+                let m0 = Vector3::new(m13[0], p[4], m13[1]);
+                y0[3] = 1.0;
+                y0[7] = 1.0;
+                y0[11] = 1.0;
+                for c in 0..3 {
+                    y0[12 + c] = p[c];
+                    y0[15 + c] = m0[c];
+                }
+                y0[18] = a0;
+                y0[19] = p[5];
+                let f = |s: f64, y: &SVector<f64, STRIP>| {
+                    let core: StripOdeState = y.fixed_rows::<21>(0).into();
+                    let mut dy = SVector::<f64, STRIP>::zeros();
+                    dy.fixed_rows_mut::<21>(0).copy_from(&strip_rhs(
+                        s,
+                        &core,
+                        regularisation,
+                        &w,
+                        &self.natural,
+                    ));
+                    dy[21] = strip_energy(y[18], y[19], regularisation, 1.0);
+                    dy[22] = w.dot(&part(y, 0));
+                    dy
+                };
+                let solved = integrate(y0, f, self.tolerance, samples)?;
+                Ok(self.solution(p, m0, solved, 20))
+            }
+        }
+    }
+
+    /// The solution from an integration whose state holds r, d1, d2, d3, n,
+    /// m first, then ∫u3 ds at `twist`, ∫W ds and ∫ w g·r ds after it.
+    fn solution<const D: usize>(
+        &self,
+        p: &Unknowns,
+        m0: Vector3<f64>,
+        (end, dense, steps): Integrated<D>,
+        twist: usize,
+    ) -> ContinuumSolution {
+        ContinuumSolution {
+            end_residual: self.end_residual(
+                [part(&end, 0), part(&end, 1), part(&end, 3)],
+                (part(&end, 4), part(&end, 5)),
+            ),
+            n0: p.fixed_rows::<3>(0).into(),
+            m0,
+            twist: end[twist] / (2.0 * PI),
+            energy: end[twist + 1] - end[twist + 2],
+            centreline: dense.iter().map(|y| part(y, 0)).collect(),
+            steps,
+        }
+    }
+
+    fn end_residual(
+        &self,
+        rd: [Vector3<f64>; 3],
+        (n1, m1): (Vector3<f64>, Vector3<f64>),
+    ) -> Vector6<f64> {
+        match self.clamps.ends.end {
+            EndKind::Clamped => end_mismatch(rd, &self.clamps),
+            EndKind::Pinned => {
+                let r = rd[0] - self.clamps.end_point();
+                Vector6::new(r[0], r[1], r[2], m1[0], m1[1], m1[2])
+            }
+            EndKind::Free => Vector6::new(n1[0], n1[1], n1[2], m1[0], m1[1], m1[2]),
+        }
+    }
+
+    /// The s = 1 residual from `p`.
+    pub fn residual(&self, p: &Unknowns) -> Result<Vector6<f64>, ContinuumError> {
+        Ok(self.solve(p, 0)?.end_residual)
+    }
+
+    /// Newton shooting from `p` on the six s = 1 conditions (Jacobian by
+    /// central differences, steps halved while the residual grows).
+    pub fn polish(&self, p: &Unknowns) -> Result<Polished, ContinuumError> {
+        let mut p = *p;
+        let mut r = self.residual(&p)?;
+        // a failed integration inside the Jacobian counts as an infinite residual
+        let res = |q: &Vector6<f64>| {
+            self.residual(q)
+                .unwrap_or_else(|_| Vector6::repeat(f64::INFINITY))
+        };
+        for iteration in 0..NEWTON_ITERATIONS {
+            if r.norm() < NEWTON_TOL {
+                return Ok(Polished {
+                    unknowns: p,
+                    residual: r.norm(),
+                    iterations: iteration,
+                });
+            }
+            let dp = central_jacobian(&p, res)
+                .lu()
+                .solve(&(-r))
+                .filter(|d| d.iter().all(|v| v.is_finite()))
+                .ok_or(ContinuumError::Singular)?;
+            let mut t = 1.0;
+            let mut next = p + dp;
+            let mut rn = res(&next);
+            for _ in 0..12 {
+                if rn.norm().is_finite() && rn.norm() < r.norm() {
+                    break;
+                }
+                t *= 0.5;
+                next = p + t * dp;
+                rn = res(&next);
+            }
+            if !rn.norm().is_finite() {
+                return Err(ContinuumError::NotConverged {
+                    iterations: iteration + 1,
+                    residual: r.norm(),
+                });
+            }
+            p = next;
+            r = rn;
+        }
+        if r.norm() < NEWTON_TOL {
+            return Ok(Polished {
+                unknowns: p,
+                residual: r.norm(),
+                iterations: NEWTON_ITERATIONS,
+            });
+        }
+        Err(ContinuumError::NotConverged {
+            iterations: NEWTON_ITERATIONS,
+            residual: r.norm(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::shooting::{ShootingSolution, refine_shooting};
+
+    fn appendix_d() -> (Continuum, Unknowns) {
+        let clamps = Clamps::new(0.115, 0.05, 0.802);
+        let c = Continuum {
+            law: ContinuumLaw::Kirchhoff { k2: 3.0, k3: 3.0 },
+            weight: Vector3::zeros(),
+            natural: NaturalStrains::default(),
+            clamps,
+            tolerance: 1e-12,
+        };
+        let p = Unknowns::new(-24.743, 17.772, 37.145, 7.5317, -8.7100, 4.529);
+        (c, p)
+    }
+
+    #[test]
+    fn the_adaptive_solution_is_the_fine_rk4_one() {
+        // the same problem by the fixed-step RK4 of shooting.rs at 40 000 steps
+        let (c, p) = appendix_d();
+        let (n, m) = refine_shooting(
+            p.fixed_rows::<3>(0).into(),
+            p.fixed_rows::<3>(3).into(),
+            3.0,
+            3.0,
+            &c.clamps,
+            40_000,
+        )
+        .unwrap();
+        let polished = c.polish(&p).unwrap();
+        let rk4 = Unknowns::new(n[0], n[1], n[2], m[0], m[1], m[2]);
+        assert!(polished.residual < NEWTON_TOL);
+        assert!(
+            (polished.unknowns - rk4).norm() < 1e-7 * rk4.norm(),
+            "{} vs {}",
+            polished.unknowns,
+            rk4
+        );
+        let tw = ShootingSolution::integrate(n, m, 3.0, 3.0, 40_000).twist();
+        let sol = c.solve(&polished.unknowns, 0).unwrap();
+        assert!((sol.twist - tw).abs() < 1e-10, "{} vs {tw}", sol.twist);
+    }
+
+    #[test]
+    fn the_energy_is_the_integral_of_the_density() {
+        // a rod bent into a circle arc by a pure moment: u1 = m1 everywhere,
+        // E = m1² / 2; n = 0 and m = (m1, 0, 0) are constant
+        let c = Continuum {
+            law: ContinuumLaw::Kirchhoff { k2: 2.0, k3: 5.0 },
+            weight: Vector3::zeros(),
+            natural: NaturalStrains::default(),
+            clamps: Clamps::new(0.5, 0.0, 0.0),
+            tolerance: 1e-12,
+        };
+        let sol = c
+            .solve(&Unknowns::new(0.0, 0.0, 0.0, 1.3, 0.0, 0.0), 11)
+            .unwrap();
+        assert!((sol.energy - 0.5 * 1.3 * 1.3).abs() < 1e-12);
+        // the arc of radius 1/1.3 in the (y, z) plane
+        for k in [3, 10] {
+            let (r, a, s) = (sol.centreline[k], 1.3f64, k as f64 / 10.0);
+            let arc = Vector3::new(0.0, -(1.0 - (a * s).cos()) / a, (a * s).sin() / a);
+            assert!((r - arc).norm() < 1e-11, "{k}: {}", (r - arc).norm());
+        }
+        assert_eq!(sol.centreline.len(), 11);
+    }
+
+    #[test]
+    fn bad_unknowns_are_named() {
+        let (c, mut p) = appendix_d();
+        p[4] = f64::NAN;
+        assert_eq!(c.solve(&p, 0).unwrap_err(), ContinuumError::NotFinite(4));
+    }
+}
