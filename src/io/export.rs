@@ -14,6 +14,9 @@ pub enum ExportFormat {
     Json,
     /// A triangle mesh of the tube.
     Obj,
+    /// Its shooting unknowns, polished on the continuum equations, as a
+    /// `[[solution]]` of a `knotrod verify` file.
+    Shooting,
 }
 
 /// Print what a recording holds.
@@ -79,6 +82,7 @@ pub fn export(path: &Path, index: u64, format: ExportFormat, out: Option<&Path>)
             .map_err(IoError::json("cannot encode the state as JSON", path))?,
         ExportFormat::Csv => csv(&msg),
         ExportFormat::Obj => obj(&msg, path, index),
+        ExportFormat::Shooting => shooting(&msg, path, index)?,
     };
     match out {
         Some(p) => std::fs::write(p, text).map_err(IoError::file("writing", p)),
@@ -135,4 +139,47 @@ fn obj(msg: &StateMessage, path: &Path, index: u64) -> String {
         }
     }
     text
+}
+
+/// The state's shooting unknowns as a `[[solution]]` of a verify file: its
+/// clamp coordinates (the paper's three, and every general one that moved)
+/// and the discrete rod's unknowns polished by Newton shooting.
+fn shooting(msg: &StateMessage, path: &Path, index: u64) -> Result<String> {
+    use crate::model::rod::Parameter;
+    use std::fmt::Write as _;
+    let u = crate::study::verify::shooting_unknowns(&msg.model, &msg.state).map_err(|e| {
+        IoError::Recording {
+            path: path.into(),
+            reason: format!("state {index}: {}", crate::study::error::describe(&e)),
+        }
+    })?;
+    let c = &msg.state.clamps;
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "# state {index} of {}: the discrete rod's unknowns at N = {} polished by Newton \
+         shooting on the continuum equations (s = 1 residual {:.1e}); at N they were\n# {:?}\n\
+         # verify with: knotrod verify FILE --scene SCENE (the scene of the recording)",
+        path.display(),
+        msg.state.segments(),
+        u.residual,
+        u.discrete
+    );
+    let _ = writeln!(t, "[[solution]]\nname = \"state {index}\"");
+    let general = !c.is_paper();
+    for p in Parameter::ALL.iter().chain(Parameter::MODEL.iter()) {
+        let v = p.value(c);
+        let paper = matches!(p, Parameter::ZStar | Parameter::Delta | Parameter::Phi);
+        if v.is_finite() && (paper || general || Parameter::MODEL.contains(p)) {
+            let _ = writeln!(t, "{} = {v:?}", p.name());
+        }
+    }
+    let p = &u.polished;
+    let _ = writeln!(t, "n0 = [{:?}, {:?}, {:?}]", p[0], p[1], p[2]);
+    if u.strip {
+        let _ = writeln!(t, "u1_0 = {:?}\nm2_0 = {:?}\nu3_0 = {:?}", p[3], p[4], p[5]);
+    } else {
+        let _ = writeln!(t, "m0 = [{:?}, {:?}, {:?}]", p[3], p[4], p[5]);
+    }
+    Ok(t)
 }

@@ -217,7 +217,16 @@ fn part<const D: usize>(y: &SVector<f64, D>, k: usize) -> Vector3<f64> {
 
 impl Continuum {
     /// The continuum problem of a discrete rod model at `clamps`.
+    /// The model's scalars that the clamps carry (a branch in K3 or the
+    /// weight) apply.
     pub fn of(model: &RodModel, clamps: Clamps, tolerance: f64) -> Result<Self, ContinuumError> {
+        let scaled;
+        let model = if clamps.scalars.is_unset() {
+            model
+        } else {
+            scaled = clamps.scalars.apply(model);
+            &scaled
+        };
         let law = match model.law {
             Law::Kirchhoff => ContinuumLaw::Kirchhoff {
                 k2: model.k2,

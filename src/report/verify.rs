@@ -67,6 +67,21 @@ pub fn input_line(c: &SolutionCheck) -> String {
     }
 }
 
+/// "; claims refuted: …" naming each refuted claim (empty if none is).
+fn refuted(c: &SolutionCheck) -> String {
+    let which: Vec<String> = c
+        .claims
+        .iter()
+        .filter(|k| !k.confirmed)
+        .map(|k| format!("{} (claimed {}, found {})", k.claim, k.claimed, k.found))
+        .collect();
+    if which.is_empty() {
+        String::new()
+    } else {
+        format!("; claims refuted: {}", which.join("; "))
+    }
+}
+
 /// The one-line verdict.
 pub fn verdict_line(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
     let inertia = |c: &SolutionCheck| match c.negative() {
@@ -82,11 +97,12 @@ pub fn verdict_line(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
         Verdict::NotASolution => format!("NOT A SOLUTION: {}", input_line(c)),
         Verdict::DifferentEquilibrium { of } => format!(
             "A DIFFERENT EQUILIBRIUM from {} at the same parameters ({}; {} is {}); both methods \
-             agree on it",
+             agree on it{}",
             all.get(*of).map_or("?", |o| o.given.name.as_str()),
             inertia(c),
             all.get(*of).map_or("?", |o| o.given.name.as_str()),
-            all.get(*of).map_or("?".into(), inertia)
+            all.get(*of).map_or("?".into(), inertia),
+            refuted(c)
         ),
         Verdict::MethodsDisagree => {
             let which: Vec<&str> = c
@@ -105,15 +121,7 @@ pub fn verdict_line(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
                 }
             )
         }
-        Verdict::ClaimsRefuted => {
-            let which: Vec<String> = c
-                .claims
-                .iter()
-                .filter(|k| !k.confirmed)
-                .map(|k| format!("{} (claimed {}, found {})", k.claim, k.claimed, k.found))
-                .collect();
-            format!("CLAIMS REFUTED: {}", which.join("; "))
-        }
+        Verdict::ClaimsRefuted => format!("CLAIMS REFUTED{}", refuted(c)),
         Verdict::Confirmed => format!(
             "CONFIRMED by both methods ({}, knot {}{}){}",
             inertia(c),

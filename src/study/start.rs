@@ -331,6 +331,41 @@ fn check_start(scene: &Scene, energy: &RodEnergy, state: &RodState) -> Result<()
     Ok(())
 }
 
+/// The equilibrium nearest the scene's initial shape at N segments, by
+/// Newton's method on ∇E = 0 for a Kirchhoff rod (a saddle too: an unstable
+/// solution given as a start stays itself, where minimisation would leave
+/// it); by minimisation if Newton does not converge from there, and for the
+/// laws with the constraint u2 = 0 (their SQP).
+pub fn equilibrium_near_start(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
+    let model = scene.rod_model(segments);
+    let mut newton = Minimizer::new(RodEnergy::with_ends(
+        model.clone(),
+        Terms::ALL,
+        scene.clamps().ends,
+    ));
+    newton.contact = scene.contact_model();
+    let start = initial_state(scene, &model)?;
+    check_start(scene, &newton.energy, &start)?;
+    let mut state = start.clone();
+    // the constrained laws (u2 = 0) converge by their SQP, not by Newton
+    let free = model.law == Law::Kirchhoff && newton.contact.is_none();
+    let newton_result = if free {
+        newton.find_equilibrium(&mut state, &scene.solver).ok()
+    } else {
+        None
+    };
+    let report = match newton_result {
+        Some(r) if r.converged => r,
+        _ => {
+            state = start;
+            newton
+                .minimize(&mut state, &scene.solver)
+                .context("Newton minimisation")?
+        }
+    };
+    Ok(analyse(&mut newton, &state, &report, &scene.measure())?)
+}
+
 /// Solve a scene's single equilibrium at N segments (the scene's own N if None).
 pub fn solve_scene(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
     let (mut newton, state, report) = starting_equilibrium(scene, segments)?;

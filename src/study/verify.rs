@@ -21,7 +21,7 @@ use crate::model::continuum::{Continuum, Polished, Unknowns};
 use crate::model::rod::{Law, Parameter};
 use crate::scene::{InitialShape, Scene};
 use crate::study::error::{Context, Result, StudyError, describe, fail};
-use crate::study::start::solve_scene;
+use crate::study::start::equilibrium_near_start;
 use serde::{Deserialize, Serialize};
 
 /// A number as printed: its value and half a unit in its last digit.
@@ -311,6 +311,8 @@ pub fn scene_of(base: &Scene, s: &Solution, options: &VerifyOptions) -> Result<S
     scene.model.stretching_stiffness = Some(options.stretching_stiffness);
     scene.initial.shape = InitialShape::Shooting;
     scene.initial.refine = false;
+    // a start's own steps (the double ring's) are not the integration's
+    scene.initial.steps = None;
     scene.initial.from_recording = None;
     scene.initial.file = None;
     scene.initial.state = None;
@@ -483,7 +485,7 @@ fn run(
     set_unknowns(&mut der_scene, &polished.unknowns.into());
     let mut eqs: Vec<Equilibrium> = Vec::new();
     for n in options.segments {
-        let e = solve_scene(&der_scene, Some(n))
+        let e = equilibrium_near_start(&der_scene, Some(n))
             .with_context(|| format!("the discrete rod at N = {n}"))?;
         check.der.push(der_row(n, &e));
         eqs.push(e);
@@ -491,7 +493,7 @@ fn run(
     // the stretching penalty's model error, O(1/S): once more at 4N, S/10
     let mut softer = der_scene.clone();
     softer.model.stretching_stiffness = Some(options.stretching_stiffness / 10.0);
-    let soft = solve_scene(&softer, Some(options.segments[2]))
+    let soft = equilibrium_near_start(&softer, Some(options.segments[2]))
         .context("the discrete rod at 4N with a tenth of the stretching stiffness")?;
     let values = |q: Quantity, e: &Equilibrium| -> Option<Vec<f64>> {
         Some(match q {
@@ -783,4 +785,56 @@ pub fn verify_all(
         }
     }
     Ok(checks)
+}
+
+/// The shooting unknowns of a discrete equilibrium: its clamp reactions
+/// (a strip's n(0), u1(0), m2(0), u3(0)) at its N, and those polished by
+/// Newton shooting on the continuum equations.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ShootingUnknowns {
+    /// From the discrete rod at its N (second-order accurate).
+    pub discrete: [f64; 6],
+    /// Polished: the continuum solution nearest them.
+    pub polished: [f64; 6],
+    /// The polished unknowns' s = 1 residual.
+    pub residual: f64,
+    /// Whether they are a strip's.
+    pub strip: bool,
+}
+
+/// The shooting unknowns of the discrete equilibrium `state` of `model`
+/// (the reverse of verify: the discrete rod finds the branch, shooting
+/// polishes it).
+pub fn shooting_unknowns(
+    model: &crate::model::rod::RodModel,
+    state: &crate::model::rod::RodState,
+) -> Result<ShootingUnknowns> {
+    use crate::model::energy::{RodEnergy, Terms};
+    use crate::model::strip_shooting::StripUnknowns;
+    let energy = RodEnergy::with_ends(model.clone(), Terms::ALL, state.clamps.ends);
+    let strip = matches!(model.law, Law::Strip { .. });
+    let discrete = if strip {
+        let p = StripUnknowns::from_der(&energy, state);
+        Unknowns::new(p.n0[0], p.n0[1], p.n0[2], p.u1, p.m2, p.u3)
+    } else {
+        let r = energy.clamp_reactions(state);
+        Unknowns::new(
+            r.force[0],
+            r.force[1],
+            r.force[2],
+            r.moment[0],
+            r.moment[1],
+            r.moment[2],
+        )
+    };
+    let continuum = Continuum::of(model, state.clamps, VerifyOptions::default().tolerance)?;
+    let polished = continuum
+        .polish(&discrete)
+        .context("polishing the discrete rod's unknowns by Newton shooting")?;
+    Ok(ShootingUnknowns {
+        discrete: discrete.into(),
+        polished: polished.unknowns.into(),
+        residual: polished.residual,
+        strip,
+    })
 }
