@@ -88,8 +88,10 @@ pub fn half_unit(literal: &str) -> f64 {
     0.5 * 10f64.powi(exponent - decimals)
 }
 
+/// A decimal literal's value and half-unit (TOML's digit separators `_` are
+/// removed before, by the TOML reader only: in CSV "3_1" is a knot's name).
 fn number(text: &str) -> Option<(f64, f64)> {
-    let v: f64 = text.trim().replace('_', "").parse().ok()?;
+    let v: f64 = text.trim().parse().ok()?;
     Some((v, half_unit(text)))
 }
 
@@ -99,11 +101,11 @@ fn toml_raw(v: &toml::de::DeValue) -> Option<Raw> {
     use toml::de::DeValue;
     Some(match v {
         DeValue::Float(f) => {
-            let (x, u) = number(f.as_str())?;
+            let (x, u) = number(&f.as_str().replace('_', ""))?;
             Raw::Number(x, u)
         }
         DeValue::Integer(i) if i.radix() == 10 => {
-            let (x, u) = number(i.as_str())?;
+            let (x, u) = number(&i.as_str().replace('_', ""))?;
             Raw::Number(x, u)
         }
         DeValue::Boolean(b) => Raw::Bool(*b),
