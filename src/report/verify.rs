@@ -327,7 +327,7 @@ pub fn markdown(
          (Dormand–Prince 8(5,3), tolerance 1e-12) from the given unknowns and polished by \
          Newton shooting; and the discrete elastic rod solved from that shape at N = {}, {}, {} \
          and Richardson-extrapolated, each quantity with the error estimate |R(N, 2N) − R(2N, \
-         4N)| and the stretching penalty's model error |q(S) − q(S/10)| / 9 at 4N. A quantity \
+         4N)| and the stretching penalty's model error |q(S) − q(S/10)| / 9 at N. A quantity \
          agrees when the two methods differ by less than three times the summed errors. A \
          printed claim is confirmed within one unit of its last digit plus those errors.\n",
         segments[0], segments[1], segments[2]
