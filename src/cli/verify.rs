@@ -113,7 +113,12 @@ pub fn verify(a: Args) -> Result<()> {
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
             .unwrap_or_default();
+        let command: Vec<String> = std::env::args()
+            .enumerate()
+            .map(|(k, a)| if k == 0 { "knotrod".into() } else { a })
+            .collect();
         let text = markdown(
+            &command.join(" "),
             &a.file.display().to_string(),
             &checks,
             options.segments,

@@ -100,6 +100,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
     let mut workloads = branch_workloads(&d, &fig3)?;
     workloads.extend(island_workloads(&fig7)?);
     workloads.push(dense_knot_workload()?);
+    workloads.push(verify_workload(scenes)?);
     // per-operation costs on the Appendix D knot resampled at each N
     let mut per: BTreeMap<String, Vec<(usize, f64)>> = BTreeMap::new();
     for n in [200, 400, 800, 1600, 3200] {
@@ -121,6 +122,28 @@ pub fn run(scenes: &Path) -> Result<Report> {
         workloads,
         exponents,
         per_call: per,
+    })
+}
+
+/// `knotrod verify` on a branch of 100 shooting solutions (the Figure 3
+/// branch, scenes/verify/branch_100.csv) at N = 100, 200, 400, in parallel.
+fn verify_workload(scenes: &Path) -> Result<Workload> {
+    use crate::study::verify::{Verdict, VerifyOptions, verify_all};
+    let (scene, solutions) = crate::io::verify_file::read_solutions(
+        &scenes.join("verify").join("branch_100.csv"),
+        Some(&scenes.join("appendix_d.toml")),
+    )
+    .map_err(|e| crate::report::error::ReportError::Failed(e.to_string()))?;
+    timed("verify_branch_100", 100, || {
+        let checks = verify_all(&scene, &solutions, &VerifyOptions::default(), &|_| {})?;
+        let confirmed = checks
+            .iter()
+            .filter(|c| c.verdict == Verdict::Confirmed)
+            .count();
+        if confirmed != checks.len() {
+            crate::report::error::fail!("verify: {confirmed} of {} confirmed", checks.len());
+        }
+        Ok(())
     })
 }
 

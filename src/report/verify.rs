@@ -15,6 +15,11 @@ fn vector(v: &[f64]) -> String {
     }
 }
 
+/// Decimals of a number printed with half-unit `half` (as it was given).
+fn printed_decimals(half: f64) -> usize {
+    (-(2.0 * half).log10()).round().clamp(0.0, 17.0) as usize
+}
+
 /// What the input is, in words.
 pub fn input_line(c: &SolutionCheck) -> String {
     let residual = c
@@ -212,8 +217,13 @@ pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
         for k in 0..6 {
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.9} | {:+.2e} | {:.0e} |",
-                names[k], c.given.unknowns[k], p[k], m[k], c.given.rounding[k]
+                "| {} | {:.*} | {:.9} | {:+.2e} | {:.0e} |",
+                names[k],
+                printed_decimals(c.given.rounding[k]),
+                c.given.unknowns[k],
+                p[k],
+                m[k],
+                c.given.rounding[k]
             );
         }
         let _ = writeln!(
@@ -314,6 +324,7 @@ pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
 /// The markdown report: how it was made, the summary, each solution, and the
 /// convergence plot if one was drawn.
 pub fn markdown(
+    command: &str,
     file: &str,
     checks: &[SolutionCheck],
     segments: [usize; 3],
@@ -321,6 +332,7 @@ pub fn markdown(
 ) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# knotrod verify: {file}\n");
+    let _ = writeln!(s, "Command: `{command}`.\n");
     let _ = writeln!(
         s,
         "Each solution is checked two ways: the continuum equations integrated adaptively \
