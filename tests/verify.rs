@@ -9,6 +9,8 @@ use knotrod::study::verify::{
 };
 use std::path::Path;
 
+mod common;
+
 fn verify(file: &str, fit: Option<Parameter>) -> Vec<SolutionCheck> {
     let (scene, solutions) = read_solutions(Path::new(file), None).unwrap();
     let options = VerifyOptions {
@@ -214,6 +216,50 @@ fn bad_solution_files_name_the_row_and_field() {
     match &checks[0].verdict {
         Verdict::Failed(why) => assert!(why.contains("delta"), "{why}"),
         v => panic!("{v:?}"),
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_command_writes_its_table_json_report_and_plot_and_refuses_bad_options() {
+    let dir = common::temp_dir("verify-cli");
+    let (json, report) = (dir.join("out.json"), dir.join("report.md"));
+    let out = common::knotrod(&[
+        "verify",
+        "scenes/verify/heavy_knot.toml",
+        "--json",
+        json.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("CONFIRMED"), "{table}");
+    let checks: Vec<SolutionCheck> =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(checks.len(), 1);
+    let md = std::fs::read_to_string(&report).unwrap();
+    assert!(md.contains("Command: `knotrod verify"), "{md}");
+    // the plot needs a font for its labels; without one the report says so
+    let plotted = dir.join("report.svg").exists() && md.contains("report.svg");
+    let said = String::from_utf8_lossy(&out.stderr).contains("no convergence plot");
+    assert!(plotted != said, "{md}");
+    for (args, says) in [
+        (vec!["--segments", "100,200"], "--segments"),
+        (vec!["--segments", "100,300,400"], "--segments"),
+        (vec!["--fit", "colour"], "--fit colour"),
+        (vec!["--stiffness=-1"], "--stiffness"),
+    ] {
+        let mut all = vec!["verify", "scenes/verify/heavy_knot.toml"];
+        all.extend(args);
+        let out = common::knotrod(&all);
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(says), "{err}");
     }
     std::fs::remove_dir_all(&dir).ok();
 }

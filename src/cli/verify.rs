@@ -108,7 +108,13 @@ pub fn verify(a: Args) -> Result<()> {
     }
     if let Some(p) = &a.report {
         let plot = p.with_extension("svg");
-        let drawn = convergence_plot(&plot, &series(&checks)).is_ok();
+        let drawn = match convergence_plot(&plot, &series(&checks)) {
+            Ok(()) => true,
+            Err(e) => {
+                eprintln!("no convergence plot: {e}");
+                false
+            }
+        };
         let name = plot
             .file_name()
             .map(|n| n.to_string_lossy().to_string())

@@ -91,6 +91,10 @@ where
 
 /// Write the plot as `path` (SVG).
 pub fn convergence_plot(path: &Path, series: &[Series]) -> Result<()> {
+    // the SVG backend measures its labels with a registered font
+    if !crate::io::plot::font_available() {
+        return Err(IoError::Plot("no font to draw the labels with".into()));
+    }
     draw(
         SVGBackend::new(path, (900, 600)).into_drawing_area(),
         series,

@@ -87,7 +87,7 @@ fn legs(eqs: &[PlotPoint]) -> Vec<Vec<&PlotPoint>> {
     out.into_iter().map(|(_, v)| v).collect()
 }
 
-fn font_available() -> bool {
+pub(crate) fn font_available() -> bool {
     use std::sync::OnceLock;
     static OK: OnceLock<bool> = OnceLock::new();
     *OK.get_or_init(|| {
