@@ -1,7 +1,7 @@
 //! Events of a path of equilibria (a branch or a loading path): what happens,
 //! where, and the paper's labels (W1, W2, X, S, F1, J1, ...).
 
-use crate::model::rod::Clamps;
+use crate::model::rod::{Clamps, Parameter};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
@@ -103,6 +103,19 @@ impl Event {
             branch,
             detail,
             clamps: (!c.is_paper() || !c.scalars.is_unset()).then_some(*c),
+        }
+    }
+
+    /// The value of parameter `p` where the event lies (φ as φ/2π): from its
+    /// whole clamps when it carries them, else from the paper's (z*, δ, φ).
+    pub fn value(&self, p: Parameter) -> f64 {
+        match (p, &self.clamps) {
+            // the stored fields, exactly as written (φ/2π is not recomputed)
+            (Parameter::ZStar, _) => self.z_star,
+            (Parameter::Delta, _) => self.delta,
+            (Parameter::Phi, _) => self.phi_over_2pi,
+            (_, Some(c)) => p.value(c),
+            (_, None) => p.value(&Clamps::new(self.z_star, self.delta, self.phi_over_2pi)),
         }
     }
 }

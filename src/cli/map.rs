@@ -135,7 +135,8 @@ fn map_plane(
             let part = Partial {
                 scene: name.to_string(),
                 spec,
-                phi_range: cont.range,
+                along: cont.parameter,
+                range: cont.range,
                 shard: sh,
                 lines,
                 traced,
@@ -151,7 +152,14 @@ fn map_plane(
             Ok(None)
         }
         None => {
-            let map = crate::study::map::assemble(name, &spec, cont.range, lines, traced);
+            let map = crate::study::map::assemble(
+                name,
+                &spec,
+                cont.parameter,
+                cont.range,
+                lines,
+                traced,
+            );
             write_map(&map, json)?;
             Ok(Some(map))
         }
@@ -207,10 +215,13 @@ fn write_map(map: &Map, json: &Path) -> Result<()> {
 fn print_map(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
     writeln!(
         out,
-        "map of {} over {} lines: good area {:.6}",
+        "map of {} over {} lines of {}: good area {:.6} in ({}, {})",
         map.scene,
         map.lines.len(),
-        map.good_area
+        map.along,
+        map.good_area,
+        map.parameter,
+        map.along
     )?;
     for (k, v) in &map.bounding_box {
         writeln!(out, "  good knots for {k} in [{:.5}, {:.5}]", v[0], v[1])?;
@@ -272,8 +283,8 @@ fn print_traced(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
     if let Some(g) = &t.grid_check {
         writeln!(
             out,
-            "  grid check: {} interval ends, largest φ/2π deviation {:.2e}, lines counting other ends: {:?}",
-            g.ends, g.max_phi_deviation, g.lines_with_other_count
+            "  grid check: {} interval ends, largest {} deviation {:.2e}, lines counting other ends: {:?}",
+            g.ends, map.along, g.max_deviation, g.lines_with_other_count
         )?;
     }
     if let Some(why) = &t.stopped {
