@@ -162,3 +162,26 @@ pub fn label_events(events: &mut [Event]) {
         };
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_event_is_placed_in_any_parameter() {
+        // the paper's clamps: no clamps kept, every coordinate from (z*, δ, φ)
+        let paper = Clamps::new(0.115, 0.05, 0.802);
+        let e = Event::at(EventKind::Wall, &paper, 0.1, 0, String::new());
+        assert!(e.clamps.is_none());
+        assert_eq!(e.value(Parameter::Phi), e.phi_over_2pi);
+        assert_eq!(e.value(Parameter::ZStar), 0.115);
+        assert_eq!(e.value(Parameter::EndTilt), 0.0);
+        assert!(e.value(Parameter::K3).is_nan());
+        // a tilted clamp carrying K3: both from the kept clamps
+        let c = Parameter::K3.with(&Parameter::EndTilt.with(&paper, -0.043), 2.5);
+        let e = Event::at(EventKind::Wall, &c, 0.1, 0, String::new());
+        assert_eq!(e.value(Parameter::EndTilt), -0.043);
+        assert_eq!(e.value(Parameter::K3), 2.5);
+        assert_eq!(e.value(Parameter::Phi), c.phi_over_2pi());
+    }
+}

@@ -152,14 +152,8 @@ fn map_plane(
             Ok(None)
         }
         None => {
-            let map = crate::study::map::assemble(
-                name,
-                &spec,
-                cont.parameter,
-                cont.range,
-                lines,
-                traced,
-            );
+            let map =
+                crate::study::map::assemble(name, &spec, cont.parameter, cont.range, lines, traced);
             write_map(&map, json)?;
             Ok(Some(map))
         }

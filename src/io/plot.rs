@@ -381,11 +381,7 @@ where
             }
             let col = colour_of(*c);
             chart
-                .draw_series(std::iter::once(Circle::new(
-                    (*x, l.value),
-                    2,
-                    col.filled(),
-                )))
+                .draw_series(std::iter::once(Circle::new((*x, l.value), 2, col.filled())))
                 .map_err(err)?;
         }
     }

@@ -255,7 +255,11 @@ pub fn branch_intervals(eqs: &[Equilibrium], events: &[Event]) -> Vec<Interval> 
 
 /// Good intervals in parameter `along` on the first branch of a run (see
 /// [`line_points`]), each bounded by that branch's events.
-pub fn branch_intervals_in(along: Parameter, eqs: &[Equilibrium], events: &[Event]) -> Vec<Interval> {
+pub fn branch_intervals_in(
+    along: Parameter,
+    eqs: &[Equilibrium],
+    events: &[Event],
+) -> Vec<Interval> {
     let first = eqs.iter().map(|e| e.branch).min().unwrap_or(0);
     let on: Vec<Event> = events
         .iter()
