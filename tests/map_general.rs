@@ -43,35 +43,62 @@ fn wall_events_around_zero(events: &[knotrod::analysis::event::Event]) -> (f64, 
     (below, above)
 }
 
-#[test]
-fn map_in_z_star_and_end_tilt_agrees_with_the_tilt_branch_and_the_walk() {
-    const N: &str = "segments = 50";
-    let dir = temp_dir("map-tilt");
-    // N = 50, six lines z* = 0.105, 0.115, ..., 0.155 (the branch point of the
-    // untilted knot lies near 0.150 at this N: the walk starts below it)
-    let scene = dir.join("map_tilt.toml");
-    std::fs::write(
-        &scene,
-        variant(
-            "scenes/map_zstar_tilt.toml",
-            &[
-                ("segments = 100", N),
-                ("range = [0.095, 0.165]", "range = [0.105, 0.155]"),
-                ("lines = 15", "lines = 6"),
-                ("grid_columns = 61", "grid_columns = 21"),
-                ("trace_from = [0.15, 0.0]", "trace_from = [0.14, 0.0]"),
-            ],
-        ),
-    )
-    .unwrap();
-    let json = dir.join("map_tilt.json");
+/// The map of a variant of a scene file (see [`variant`]), run by
+/// `knotrod map` in a fresh directory and read back.
+fn map_of(name: &str, file: &str, replace: &[(&str, &str)]) -> Map {
+    let dir = temp_dir(name);
+    let scene = dir.join(format!("{name}.toml"));
+    std::fs::write(&scene, variant(file, replace)).unwrap();
+    let json = dir.join(format!("{name}.json"));
     knotrod_ok(&[
         "map",
         scene.to_str().unwrap(),
         "--json",
         json.to_str().unwrap(),
     ]);
-    let map: Map = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap()
+}
+
+/// How often the traced boundary crosses the map's lines, each crossing
+/// required within `tol` of one of that line's interval ends.
+fn crossings_at_interval_ends(map: &Map, tol: f64) -> usize {
+    let t = map.traced.as_ref().expect("the boundary was traced");
+    let mut cuts = 0;
+    for l in &map.lines {
+        let ends: Vec<f64> = l.intervals.iter().flat_map(|i| [i.lo, i.hi]).collect();
+        for c in t.cuts(l.value) {
+            let d = ends
+                .iter()
+                .map(|e| (e - c).abs())
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                d < tol,
+                "{} = {}: the walk crosses at {c}, {d} from the grid's ends {ends:?}",
+                map.parameter,
+                l.value
+            );
+            cuts += 1;
+        }
+    }
+    cuts
+}
+
+#[test]
+fn map_in_z_star_and_end_tilt_agrees_with_the_tilt_branch_and_the_walk() {
+    const N: &str = "segments = 50";
+    // N = 50, six lines z* = 0.105, 0.115, ..., 0.155 (the branch point of the
+    // untilted knot lies near 0.150 at this N: the walk starts below it)
+    let map = map_of(
+        "map-tilt",
+        "scenes/map_zstar_tilt.toml",
+        &[
+            ("segments = 100", N),
+            ("range = [0.095, 0.165]", "range = [0.105, 0.155]"),
+            ("lines = 15", "lines = 6"),
+            ("grid_columns = 61", "grid_columns = 21"),
+            ("trace_from = [0.15, 0.0]", "trace_from = [0.14, 0.0]"),
+        ],
+    );
     assert_eq!(
         (map.parameter.as_str(), map.along.as_str()),
         ("z_star", "end_tilt")
@@ -141,22 +168,7 @@ fn map_in_z_star_and_end_tilt_agrees_with_the_tilt_branch_and_the_walk() {
     for p in &t.pieces {
         assert!(["W1", "W2"].contains(&p.label.as_str()), "{}", p.label);
     }
-    let mut cuts = 0;
-    for l in &map.lines {
-        let ends: Vec<f64> = l.intervals.iter().flat_map(|i| [i.lo, i.hi]).collect();
-        for c in t.cuts(l.value) {
-            let d = ends
-                .iter()
-                .map(|e| (e - c).abs())
-                .fold(f64::INFINITY, f64::min);
-            assert!(
-                d < 2e-4,
-                "z* = {}: traced tilt {c} is {d} from the grid's ends {ends:?}",
-                l.value
-            );
-            cuts += 1;
-        }
-    }
+    let cuts = crossings_at_interval_ends(&map, 2e-4);
     assert!(cuts >= 6, "the walk crosses the lines {cuts} times");
     if t.closed {
         let g = t.grid_check.as_ref().unwrap();
@@ -226,32 +238,19 @@ fn a_map_along_its_own_swept_parameter_is_refused_naming_the_field() {
 fn a_map_whose_lines_run_in_a_model_scalar_places_them_by_it() {
     // Figure 7-left's knot at N = 40, each line a branch in K3 (a scalar of
     // the model, carried by the states because the scene varies it)
-    let dir = temp_dir("map-k3");
-    let scene = dir.join("map_k3.toml");
-    std::fs::write(
-        &scene,
-        variant(
-            "scenes/fig7_island_kirchhoff.toml",
-            &[
-                ("segments = 100", "segments = 40"),
-                ("parameter = \"phi\"", "parameter = \"K3\""),
-                ("range = [0.65, 1.1]", "range = [1.5, 5.0]"),
-                ("max_step = 0.01", "max_step = 0.05"),
-                ("range = [0.04, 0.30]", "range = [0.10, 0.145]"),
-                ("lines = 27", "lines = 4"),
-                ("grid_columns = 91", "grid_columns = 21"),
-            ],
-        ),
-    )
-    .unwrap();
-    let json = dir.join("map_k3.json");
-    knotrod_ok(&[
-        "map",
-        scene.to_str().unwrap(),
-        "--json",
-        json.to_str().unwrap(),
-    ]);
-    let map: Map = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let map = map_of(
+        "map-k3",
+        "scenes/fig7_island_kirchhoff.toml",
+        &[
+            ("segments = 100", "segments = 40"),
+            ("parameter = \"phi\"", "parameter = \"K3\""),
+            ("range = [0.65, 1.1]", "range = [1.5, 5.0]"),
+            ("max_step = 0.01", "max_step = 0.05"),
+            ("range = [0.04, 0.30]", "range = [0.10, 0.145]"),
+            ("lines = 27", "lines = 4"),
+            ("grid_columns = 91", "grid_columns = 21"),
+        ],
+    );
     assert_eq!(map.along, "K3");
     // z* = 0.10 lies left of the region; 0.115 (the walk's start, K3 = 3),
     // 0.13 and 0.145 cross it
@@ -288,17 +287,6 @@ fn a_map_whose_lines_run_in_a_model_scalar_places_them_by_it() {
     // the stability boundary in (z*, K3) to the map's edge
     let t = map.traced.as_ref().unwrap();
     assert!(t.pieces.iter().any(|p| p.label == "S"), "{:?}", t.stopped);
-    let mut cuts = 0;
-    for l in &map.lines {
-        let ends: Vec<f64> = l.intervals.iter().flat_map(|i| [i.lo, i.hi]).collect();
-        for c in t.cuts(l.value) {
-            let d = ends
-                .iter()
-                .map(|e| (e - c).abs())
-                .fold(f64::INFINITY, f64::min);
-            assert!(d < 2e-4, "z* = {}: traced K3 {c}, grid {ends:?}", l.value);
-            cuts += 1;
-        }
-    }
+    let cuts = crossings_at_interval_ends(&map, 2e-4);
     assert!(cuts >= 2, "the walk crosses the lines {cuts} times");
 }

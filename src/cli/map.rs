@@ -3,6 +3,7 @@
 use super::progress::Progress;
 use crate::io::json::write_pretty;
 use crate::io::map_files::{LineFolder, Partial, merge as merge_parts, trace_cached};
+use crate::io::plot::axis_label;
 use crate::scene::MapSpec;
 use crate::scene::{Job, Scene};
 use crate::study::boundary::Traced;
@@ -207,15 +208,13 @@ fn write_map(map: &Map, json: &Path) -> Result<()> {
 
 /// The map's region line by line, and its traced boundary.
 fn print_map(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
+    let (swept, along) = (axis_label(&map.parameter), axis_label(&map.along));
     writeln!(
         out,
-        "map of {} over {} lines of {}: good area {:.6} in ({}, {})",
+        "map of {} over {} lines of {along}: good area {:.6} in ({swept}, {along})",
         map.scene,
         map.lines.len(),
-        map.along,
         map.good_area,
-        map.parameter,
-        map.along
     )?;
     for (k, v) in &map.bounding_box {
         writeln!(out, "  good knots for {k} in [{:.5}, {:.5}]", v[0], v[1])?;
@@ -278,7 +277,10 @@ fn print_traced(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
         writeln!(
             out,
             "  grid check: {} interval ends, largest {} deviation {:.2e}, lines counting other ends: {:?}",
-            g.ends, map.along, g.max_deviation, g.lines_with_other_count
+            g.ends,
+            axis_label(&map.along),
+            g.max_deviation,
+            g.lines_with_other_count
         )?;
     }
     if let Some(why) = &t.stopped {

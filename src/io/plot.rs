@@ -340,7 +340,7 @@ pub fn island_slices(
 
 /// A map axis's label: a parameter's name as the paper writes it where it
 /// has a symbol (φ/2π, z*, δ), else its name in scenes.
-fn axis_label(name: &str) -> &str {
+pub fn axis_label(name: &str) -> &str {
     match name {
         "phi_over_2pi" => "φ/2π",
         "z_star" => "z*",
