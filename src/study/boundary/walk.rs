@@ -59,6 +59,15 @@ struct Walk<'t, 'a> {
     equilibria: usize,
 }
 
+/// A parameter in messages: φ as the paper writes it, others by their name.
+fn label(p: Parameter) -> &'static str {
+    if p == Parameter::Phi {
+        "φ/2π"
+    } else {
+        p.name()
+    }
+}
+
 fn unit(v: [f64; 2]) -> [f64; 2] {
     let n = v[0].hypot(v[1]).max(1e-300);
     [v[0] / n, v[1] / n]
@@ -110,9 +119,9 @@ impl Walk<'_, '_> {
                 .with_context(|| {
                     format!(
                         "equilibrium at {} = {:.6}, {} = {:.6}",
-                        self.swept.name(),
+                        label(self.swept),
                         q[0],
-                        self.along.name(),
+                        label(self.along),
                         q[1]
                     )
                 })?;
@@ -388,17 +397,17 @@ pub fn trace_island(
     if !p0.iter().all(|v| v.is_finite()) {
         fail!(
             "the boundary walk's start: the scene's start carries no value of {} or {}",
-            swept.name(),
-            along.name()
+            label(swept),
+            label(along)
         );
     }
     if !walk.inside(spec.trace_from.unwrap_or(p0)) {
         fail!(
             "the boundary walk's start ({} = {}, {} = {}: map.trace_from or the scene's \
              start) lies outside the map's range",
-            swept.name(),
+            label(swept),
             spec.trace_from.unwrap_or(p0)[0],
-            along.name(),
+            label(along),
             spec.trace_from.unwrap_or(p0)[1]
         );
     }
@@ -418,9 +427,9 @@ pub fn trace_island(
         fail!(
             "the boundary walk starts from a good knot (map.trace_from, or the scene's start); \
              at {} = {}, {} = {} {f}",
-            swept.name(),
+            label(swept),
             p0[0],
-            along.name(),
+            label(along),
             p0[1]
         );
     }
@@ -509,7 +518,7 @@ fn first_boundary(walk: &mut Walk, start: Site) -> Result<(Condition, Step)> {
         if !walk.inside(p) {
             fail!(
                 "no boundary above the start within the range of {}",
-                walk.along.name()
+                label(walk.along)
             );
         }
         let s = walk.equilibrium_at(&good, p)?;
