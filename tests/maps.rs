@@ -158,7 +158,7 @@ fn island_boundary_traced_directly_agrees_with_the_grid() {
     assert!(check["ends"].as_u64().unwrap() >= 8);
     // measured 2.4e-5: the chords of the traced polyline (steps up to 0.005)
     // against bisected events; a boundary off by a grid step would fail
-    assert!(check["max_phi_deviation"].as_f64().unwrap() < 2e-4);
+    assert!(check["max_deviation"].as_f64().unwrap() < 2e-4);
     assert!(
         check["lines_with_other_count"]
             .as_array()

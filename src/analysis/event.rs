@@ -1,7 +1,7 @@
 //! Events of a path of equilibria (a branch or a loading path): what happens,
 //! where, and the paper's labels (W1, W2, X, S, F1, J1, ...).
 
-use crate::model::rod::Clamps;
+use crate::model::rod::{Clamps, Parameter};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
@@ -105,6 +105,19 @@ impl Event {
             clamps: (!c.is_paper() || !c.scalars.is_unset()).then_some(*c),
         }
     }
+
+    /// The value of parameter `p` where the event lies (φ as φ/2π): from its
+    /// whole clamps when it carries them, else from the paper's (z*, δ, φ).
+    pub fn value(&self, p: Parameter) -> f64 {
+        match (p, &self.clamps) {
+            // the stored fields, exactly as written (φ/2π is not recomputed)
+            (Parameter::ZStar, _) => self.z_star,
+            (Parameter::Delta, _) => self.delta,
+            (Parameter::Phi, _) => self.phi_over_2pi,
+            (_, Some(c)) => p.value(c),
+            (_, None) => p.value(&Clamps::new(self.z_star, self.delta, self.phi_over_2pi)),
+        }
+    }
 }
 
 /// Label events as in the paper's figures: walls W1, W2, … by increasing φ on
@@ -147,5 +160,28 @@ pub fn label_events(events: &mut [Event]) {
         } else {
             prefix.to_string()
         };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_event_is_placed_in_any_parameter() {
+        // the paper's clamps: no clamps kept, every coordinate from (z*, δ, φ)
+        let paper = Clamps::new(0.115, 0.05, 0.802);
+        let e = Event::at(EventKind::Wall, &paper, 0.1, 0, String::new());
+        assert!(e.clamps.is_none());
+        assert_eq!(e.value(Parameter::Phi), e.phi_over_2pi);
+        assert_eq!(e.value(Parameter::ZStar), 0.115);
+        assert_eq!(e.value(Parameter::EndTilt), 0.0);
+        assert!(e.value(Parameter::K3).is_nan());
+        // a tilted clamp carrying K3: both from the kept clamps
+        let c = Parameter::K3.with(&Parameter::EndTilt.with(&paper, -0.043), 2.5);
+        let e = Event::at(EventKind::Wall, &c, 0.1, 0, String::new());
+        assert_eq!(e.value(Parameter::EndTilt), -0.043);
+        assert_eq!(e.value(Parameter::K3), 2.5);
+        assert_eq!(e.value(Parameter::Phi), c.phi_over_2pi());
     }
 }

@@ -3,6 +3,7 @@
 use super::progress::Progress;
 use crate::io::json::write_pretty;
 use crate::io::map_files::{LineFolder, Partial, merge as merge_parts, trace_cached};
+use crate::io::plot::axis_label;
 use crate::scene::MapSpec;
 use crate::scene::{Job, Scene};
 use crate::study::boundary::Traced;
@@ -135,7 +136,8 @@ fn map_plane(
             let part = Partial {
                 scene: name.to_string(),
                 spec,
-                phi_range: cont.range,
+                along: cont.parameter,
+                range: cont.range,
                 shard: sh,
                 lines,
                 traced,
@@ -151,7 +153,8 @@ fn map_plane(
             Ok(None)
         }
         None => {
-            let map = crate::study::map::assemble(name, &spec, cont.range, lines, traced);
+            let map =
+                crate::study::map::assemble(name, &spec, cont.parameter, cont.range, lines, traced);
             write_map(&map, json)?;
             Ok(Some(map))
         }
@@ -205,12 +208,13 @@ fn write_map(map: &Map, json: &Path) -> Result<()> {
 
 /// The map's region line by line, and its traced boundary.
 fn print_map(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
+    let (swept, along) = (axis_label(&map.parameter), axis_label(&map.along));
     writeln!(
         out,
-        "map of {} over {} lines: good area {:.6}",
+        "map of {} over {} lines of {along}: good area {:.6} in ({swept}, {along})",
         map.scene,
         map.lines.len(),
-        map.good_area
+        map.good_area,
     )?;
     for (k, v) in &map.bounding_box {
         writeln!(out, "  good knots for {k} in [{:.5}, {:.5}]", v[0], v[1])?;
@@ -272,8 +276,11 @@ fn print_traced(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
     if let Some(g) = &t.grid_check {
         writeln!(
             out,
-            "  grid check: {} interval ends, largest φ/2π deviation {:.2e}, lines counting other ends: {:?}",
-            g.ends, g.max_phi_deviation, g.lines_with_other_count
+            "  grid check: {} interval ends, largest {} deviation {:.2e}, lines counting other ends: {:?}",
+            g.ends,
+            axis_label(&map.along),
+            g.max_deviation,
+            g.lines_with_other_count
         )?;
     }
     if let Some(why) = &t.stopped {

@@ -89,7 +89,8 @@ pub enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Map the good-knot region: a branch in φ per value of a second parameter.
+    /// Map the good-knot region: a branch in the continuation's parameter (φ for the
+    /// paper's maps) per value of the map's parameter.
     Map {
         /// Scene with [continuation] (the branches) and [map] (the grid).
         scene: PathBuf,

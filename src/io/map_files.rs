@@ -2,6 +2,7 @@
 //! output (an interrupted map resumes from them), and the partial results of
 //! shards and their merge.
 
+use crate::model::rod::Parameter;
 use crate::scene::{MapSpec, Scene};
 use crate::study::boundary::{Traced, trace_island};
 use crate::study::error::{StudyError, describe};
@@ -170,8 +171,13 @@ pub struct Partial {
     pub scene: String,
     /// The map settings.
     pub spec: MapSpec,
-    /// φ range of the lines.
-    pub phi_range: [f64; 2],
+    /// The parameter along the lines (the continuation's; partial maps
+    /// written before it was kept ran in φ).
+    #[serde(default = "phi")]
+    pub along: Parameter,
+    /// Its range along the lines.
+    #[serde(alias = "phi_range")]
+    pub range: [f64; 2],
     /// Shard (i, n).
     pub shard: (usize, usize),
     /// Its lines.
@@ -179,6 +185,10 @@ pub struct Partial {
     /// The traced boundary (shard 0 computes it).
     #[serde(default)]
     pub traced: Option<Traced>,
+}
+
+fn phi() -> Parameter {
+    Parameter::Phi
 }
 
 /// Merge partial results into a map.
@@ -202,7 +212,7 @@ pub fn merge(parts: &[PathBuf]) -> Result<Map, MapFileError> {
     }
     let h =
         head.ok_or_else(|| MapFileError::Merge("merge needs at least one partial result".into()))?;
-    let map = assemble(&h.scene, &h.spec, h.phi_range, all, traced);
+    let map = assemble(&h.scene, &h.spec, h.along, h.range, all, traced);
     let missing: Vec<usize> = (0..h.spec.lines)
         .filter(|k| !map.lines.iter().any(|l| l.index == *k))
         .collect();

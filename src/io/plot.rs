@@ -283,7 +283,8 @@ pub fn bifurcation_diagram(
 }
 
 /// The island map: classified grid as dots (colours as in the diagrams) and
-/// the boundary curves labelled, in the (φ/2π, swept parameter) plane.
+/// the boundary curves labelled, in the (value along the lines, swept parameter)
+/// plane: (φ/2π, z*) for the paper's maps.
 pub fn island_map(stem: &Path, map: &crate::study::map::Map) -> Result<Vec<std::path::PathBuf>> {
     let mut written = Vec::new();
     let fonts = font_available();
@@ -337,6 +338,17 @@ pub fn island_slices(
     Ok(written)
 }
 
+/// A map axis's label: a parameter's name as the paper writes it where it
+/// has a symbol (φ/2π, z*, δ), else its name in scenes.
+pub fn axis_label(name: &str) -> &str {
+    match name {
+        "phi_over_2pi" => "φ/2π",
+        "z_star" => "z*",
+        "delta" => "δ",
+        other => other,
+    }
+}
+
 fn draw_map<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     map: &crate::study::map::Map,
@@ -346,7 +358,7 @@ where
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     root.fill(&WHITE).map_err(err)?;
-    let (x0, x1) = bounds(&map.grid_phi);
+    let (x0, x1) = bounds(&map.grid_along);
     let values: Vec<f64> = map.lines.iter().map(|l| l.value).collect();
     let (y0, y1) = bounds(&values);
     let mut chart = ChartBuilder::on(&root)
@@ -358,22 +370,18 @@ where
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc("φ/2π")
-        .y_desc(map.parameter.as_str())
+        .x_desc(axis_label(&map.along))
+        .y_desc(axis_label(&map.parameter))
         .draw()
         .map_err(err)?;
     for (row, l) in map.grid.iter().zip(&map.lines) {
-        for (c, phi) in row.iter().zip(&map.grid_phi) {
+        for (c, x) in row.iter().zip(&map.grid_along) {
             if *c == Class::None {
                 continue;
             }
             let col = colour_of(*c);
             chart
-                .draw_series(std::iter::once(Circle::new(
-                    (*phi, l.value),
-                    2,
-                    col.filled(),
-                )))
+                .draw_series(std::iter::once(Circle::new((*x, l.value), 2, col.filled())))
                 .map_err(err)?;
         }
     }

@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MapSpec {
-    /// The swept parameter (default z_star).
+    /// The swept parameter (default z_star); each line is a branch in the
+    /// `[continuation]`'s parameter at one value of it.
     #[serde(default = "default_sweep")]
     pub parameter: Parameter,
     /// Its values, evenly spaced from range[0] to range[1].
@@ -18,11 +19,13 @@ pub struct MapSpec {
     /// Columns of the classified grid.
     #[serde(default = "default_columns")]
     pub grid_columns: usize,
-    /// A known good knot (parameter, φ/2π) the boundary walk starts from,
+    /// A known good knot (map parameter, continuation parameter; φ as φ/2π)
+    /// the boundary walk starts from,
     /// reached from the scene's start in a straight line (default: the start).
     #[serde(default, deserialize_with = "crate::scene::exact::option")]
     pub trace_from: Option<[f64; 2]>,
-    /// Largest step of the boundary walk in the (parameter, φ/2π) plane.
+    /// Largest step of the boundary walk in the (map parameter, continuation
+    /// parameter) plane.
     #[serde(default = "default_trace_step")]
     pub trace_step: f64,
     /// A 3D map: one such map per value of a third parameter.

@@ -650,8 +650,18 @@ impl Scene {
     /// `[map]` and `[map.slices]`.
     fn check_map(&self) -> Result<(), SceneError> {
         if let Some(m) = &self.map {
-            if self.continuation.is_none() {
+            let Some(cont) = &self.continuation else {
                 return Err(invalid("map", "needs a [continuation] giving the branches"));
+            };
+            if cont.parameter == m.parameter {
+                return Err(invalid(
+                    "map.parameter",
+                    format!(
+                        "must differ from continuation.parameter (both {}): the lines are \
+                         branches in the one at values of the other",
+                        m.parameter.name()
+                    ),
+                ));
             }
             finite("map.range", m.range[0])?;
             finite("map.range", m.range[1])?;

@@ -1,6 +1,7 @@
 //! Parameter-space maps: the island of good knots (paper Fig. 7) from a grid of
-//! one-parameter branches — a branch in φ at each value of a second parameter
-//! (z*), each reached independently by continuation from the scene's start,
+//! one-parameter branches — a branch in the continuation's parameter (φ for
+//! the paper's maps) at each value of the swept parameter (z*), each reached
+//! independently by continuation from the scene's start,
 //! computed in parallel (rayon) and deterministic whatever the thread count.
 //! Good intervals are bounded by the located events (S, W1, W2, X), which form
 //! the boundary curves. Maps shard (`--shard i/n`, `knotrod merge`) and resume
@@ -9,6 +10,7 @@
 use crate::analysis::class::Class;
 use crate::analysis::equilibrium::{Equilibrium, Measure};
 use crate::analysis::event::{Event, EventKind};
+use crate::model::rod::Parameter;
 use crate::scene::{MapSpec, Scene, SliceSpec};
 use crate::study::boundary::{GridCheck, Traced};
 use crate::study::branch::{BranchOptions, BranchRun};
@@ -21,8 +23,9 @@ use std::collections::BTreeMap;
 /// A point of a line of the map.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct LinePoint {
-    /// φ/2π.
-    pub phi_over_2pi: f64,
+    /// Value of the parameter along the line (the continuation's; φ as φ/2π).
+    #[serde(alias = "phi_over_2pi")]
+    pub along: f64,
     /// Tw.
     pub twist: f64,
     /// Class.
@@ -32,9 +35,9 @@ pub struct LinePoint {
 /// An interval of good knots along a line, with what bounds it.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Interval {
-    /// Lower φ/2π.
+    /// Lower end, in the parameter along the line.
     pub lo: f64,
-    /// Upper φ/2π.
+    /// Upper end.
     pub hi: f64,
     /// Boundary label at the lower end (S, W1, X, range, ...).
     pub lo_label: String,
@@ -52,7 +55,8 @@ impl std::fmt::Display for Interval {
     }
 }
 
-/// One line of the map: the branch in φ at one value of the swept parameter.
+/// One line of the map: the branch along the continuation's parameter at one
+/// value of the swept parameter.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Line {
     /// Index in the map's grid.
@@ -76,9 +80,12 @@ pub struct Map {
     pub scene: String,
     /// The swept parameter (the map's vertical axis).
     pub parameter: String,
+    /// The parameter along each line (the continuation's: the horizontal axis).
+    #[serde(default = "phi_name")]
+    pub along: String,
     /// Lines, by increasing index.
     pub lines: Vec<Line>,
-    /// Named boundary curves, (swept value, φ/2π) points: the traced
+    /// Named boundary curves, (swept value, value along) points: the traced
     /// boundary's pieces when it was traced, else the grid's.
     pub boundaries: BTreeMap<String, Vec<[f64; 2]>>,
     /// Boundary curves chained from the grid's interval ends (the check).
@@ -87,14 +94,21 @@ pub struct Map {
     /// The boundary traced by two-parameter continuation from the start.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub traced: Option<Traced>,
-    /// Classified grid: rows = lines, columns = `grid_phi`.
+    /// Classified grid: rows = lines, columns = `grid_along`.
     pub grid: Vec<Vec<Class>>,
-    /// φ/2π of the grid columns.
-    pub grid_phi: Vec<f64>,
-    /// Area of the good region in the (swept, φ/2π) plane.
+    /// Values along the lines of the grid columns.
+    #[serde(alias = "grid_phi")]
+    pub grid_along: Vec<f64>,
+    /// Area of the good region in the (swept, along) plane.
     pub good_area: f64,
-    /// {"swept": [lo, hi], "phi_over_2pi": [lo, hi]} of the good region.
+    /// {swept: [lo, hi], along: [lo, hi]} of the good region, keyed by the
+    /// parameters' names.
     pub bounding_box: BTreeMap<String, [f64; 2]>,
+}
+
+/// Maps written before maps took any parameter along their lines ran in φ.
+fn phi_name() -> String {
+    Parameter::Phi.name().into()
 }
 
 /// A 3D map: its slices and the good region's volume and bounding box.
@@ -110,7 +124,7 @@ pub struct Map3 {
     pub slice_values: Vec<f64>,
     /// Good area of each slice.
     pub slice_areas: Vec<f64>,
-    /// Volume of the good region in (slice, swept, φ/2π) (trapezoids across
+    /// Volume of the good region in (slice, swept, along) (trapezoids across
     /// the slices).
     pub good_volume: f64,
     /// Bounding box of the good region over all slices.
@@ -165,8 +179,9 @@ pub fn assemble_3d(scene: &str, spec: &SliceSpec, slices: Vec<Map>) -> Map3 {
 }
 
 /// The classified points of the first branch of a run (the lowest branch
-/// number), in order along it (second leg reversed, then the first).
-pub fn line_points(eqs: &[Equilibrium]) -> Vec<LinePoint> {
+/// number) placed by parameter `along`, in order along the branch (second
+/// leg reversed, then the first).
+pub fn line_points(eqs: &[Equilibrium], along: Parameter) -> Vec<LinePoint> {
     let first = eqs.iter().map(|e| e.branch).min().unwrap_or(0);
     let mut down: Vec<&Equilibrium> = eqs
         .iter()
@@ -176,7 +191,7 @@ pub fn line_points(eqs: &[Equilibrium]) -> Vec<LinePoint> {
     down.into_iter()
         .chain(eqs.iter().filter(|e| e.branch == first && e.leg == 0))
         .map(|e| LinePoint {
-            phi_over_2pi: e.phi_over_2pi,
+            along: along.value(&e.state.clamps),
             twist: e.twist,
             class: Class::of(e.stable, e.knotted, e.good_knot),
         })
@@ -184,15 +199,22 @@ pub fn line_points(eqs: &[Equilibrium]) -> Vec<LinePoint> {
 }
 
 /// The event that bounds a good run between branch points `p` and `q`: the one
-/// nearest to that segment in the (φ/2π, Tw) plane (the branch may pass the
-/// same φ several times).
-fn boundary_label(events: &[Event], p: &LinePoint, q: &LinePoint, lower: bool) -> (f64, String) {
-    let (ax, ay, bx, by) = (p.phi_over_2pi, p.twist, q.phi_over_2pi, q.twist);
+/// nearest to that segment in the (along, Tw) plane (the branch may pass the
+/// same value several times).
+fn boundary_label(
+    events: &[Event],
+    along: Parameter,
+    p: &LinePoint,
+    q: &LinePoint,
+    lower: bool,
+) -> (f64, String) {
+    let (ax, ay, bx, by) = (p.along, p.twist, q.along, q.twist);
     let dist = |e: &Event| {
         let (dx, dy) = (bx - ax, by - ay);
         let len2 = (dx * dx + dy * dy).max(1e-300);
-        let t = (((e.phi_over_2pi - ax) * dx + (e.twist - ay) * dy) / len2).clamp(0.0, 1.0);
-        ((e.phi_over_2pi - ax - t * dx).powi(2) + (e.twist - ay - t * dy).powi(2)).sqrt()
+        let x = e.value(along);
+        let t = (((x - ax) * dx + (e.twist - ay) * dy) / len2).clamp(0.0, 1.0);
+        ((x - ax - t * dx).powi(2) + (e.twist - ay - t * dy).powi(2)).sqrt()
     };
     let scale = ((bx - ax).powi(2) + (by - ay).powi(2)).sqrt();
     let best = events
@@ -219,27 +241,38 @@ fn boundary_label(events: &[Event], p: &LinePoint, q: &LinePoint, lower: bool) -
                 (EventKind::Fold, _) => "F",
                 _ => "S",
             };
-            (e.phi_over_2pi, label.to_string())
+            (e.value(along), label.to_string())
         }
         None => (0.5 * (ax + bx), "?".to_string()),
     }
 }
 
-/// Good intervals along the first branch of a run (see [`line_points`]),
-/// each bounded by that branch's events.
+/// Good intervals of φ/2π along the first branch of a run in φ (the paper's
+/// branches; see [`branch_intervals_in`]).
 pub fn branch_intervals(eqs: &[Equilibrium], events: &[Event]) -> Vec<Interval> {
+    branch_intervals_in(Parameter::Phi, eqs, events)
+}
+
+/// Good intervals in parameter `along` on the first branch of a run (see
+/// [`line_points`]), each bounded by that branch's events.
+pub fn branch_intervals_in(
+    along: Parameter,
+    eqs: &[Equilibrium],
+    events: &[Event],
+) -> Vec<Interval> {
     let first = eqs.iter().map(|e| e.branch).min().unwrap_or(0);
     let on: Vec<Event> = events
         .iter()
         .filter(|e| e.branch == first)
         .cloned()
         .collect();
-    intervals_of(&line_points(eqs), &on)
+    intervals_of(&line_points(eqs, along), &on, along)
 }
 
 /// Good intervals of a line: maximal runs of good points, bounded by the
-/// events (of the same branch) between their ends and the neighbouring points.
-pub fn intervals_of(points: &[LinePoint], events: &[Event]) -> Vec<Interval> {
+/// events (of the same branch) between their ends and the neighbouring
+/// points, placed by parameter `along`.
+pub fn intervals_of(points: &[LinePoint], events: &[Event], along: Parameter) -> Vec<Interval> {
     let mut intervals = Vec::new();
     let good: Vec<bool> = points.iter().map(|p| p.class == Class::Good).collect();
     let mut k = 0;
@@ -253,25 +286,27 @@ pub fn intervals_of(points: &[LinePoint], events: &[Event]) -> Vec<Interval> {
             k += 1;
         }
         let end = k - 1;
-        let phi = |i: usize| points[i].phi_over_2pi;
+        let x = |i: usize| points[i].along;
         let (a, la) = if start == 0 {
-            (phi(0), "range".to_string())
+            (x(0), "range".to_string())
         } else {
             boundary_label(
                 events,
+                along,
                 &points[start - 1],
                 &points[start],
-                phi(start - 1) < phi(start),
+                x(start - 1) < x(start),
             )
         };
         let (b, lb) = if end + 1 == good.len() {
-            (phi(end), "range".to_string())
+            (x(end), "range".to_string())
         } else {
             boundary_label(
                 events,
+                along,
                 &points[end],
                 &points[end + 1],
-                phi(end + 1) < phi(end),
+                x(end + 1) < x(end),
             )
         };
         let (lo, hi, lo_label, hi_label) = if a <= b {
@@ -301,9 +336,9 @@ pub fn line(scene: &Scene, spec: &MapSpec, index: usize, segments: Option<usize>
         error: None,
     };
     match compute_line(scene, spec, value, segments) {
-        Ok((eqs, events)) => {
-            out.points = line_points(&eqs);
-            out.intervals = branch_intervals(&eqs, &events);
+        Ok((eqs, events, along)) => {
+            out.points = line_points(&eqs, along);
+            out.intervals = branch_intervals_in(along, &eqs, &events);
             out.events = events;
         }
         Err(e) => out.error = Some(describe(&e)),
@@ -316,11 +351,11 @@ fn compute_line(
     spec: &MapSpec,
     value: f64,
     segments: Option<usize>,
-) -> Result<(Vec<Equilibrium>, Vec<Event>)> {
+) -> Result<(Vec<Equilibrium>, Vec<Event>, Parameter)> {
     let c = scene
         .continuation
         .as_ref()
-        .context("[map] needs a [continuation] in φ")?;
+        .context("[map] needs a [continuation] giving the branches")?;
     let (mut newton, state, _) = starting_equilibrium(scene, segments)?;
     let settings = c.settings();
     let state = continue_to(&mut newton, state, spec.parameter, value, &settings)?;
@@ -344,7 +379,7 @@ fn compute_line(
     run.follow(state, &[1.0, -1.0])?;
     let events = std::mem::take(&mut run.events);
     drop(run);
-    Ok((eqs, events))
+    Ok((eqs, events, c.parameter))
 }
 
 /// Lines of shard `i` of `n`.
@@ -390,29 +425,30 @@ pub fn compute_lines(
     Ok(lines)
 }
 
-/// Assemble a map from its lines (boundaries, grid, area, bounding box).
+/// Assemble a map from its lines (boundaries, grid, area, bounding box):
+/// lines along parameter `along` over `range` (the continuation's).
 pub fn assemble(
     scene_name: &str,
     spec: &MapSpec,
-    phi_range: [f64; 2],
+    along: Parameter,
+    range: [f64; 2],
     mut lines: Vec<Line>,
     traced: Option<Traced>,
 ) -> Map {
     lines.sort_by_key(|l| l.index);
     lines.dedup_by_key(|l| l.index);
     for l in lines.iter_mut() {
-        l.intervals = intervals_of(&l.points, &l.events);
+        l.intervals = intervals_of(&l.points, &l.events, along);
     }
-    let grid_phi: Vec<f64> = (0..spec.grid_columns)
+    let grid_along: Vec<f64> = (0..spec.grid_columns)
         .map(|j| {
-            phi_range[0]
-                + (phi_range[1] - phi_range[0]) * j as f64 / (spec.grid_columns.max(2) - 1) as f64
+            range[0] + (range[1] - range[0]) * j as f64 / (spec.grid_columns.max(2) - 1) as f64
         })
         .collect();
-    let grid = lines.iter().map(|l| grid_row(l, &grid_phi)).collect();
+    let grid = lines.iter().map(|l| grid_row(l, &grid_along)).collect();
     let mut ends: Vec<(usize, f64, f64, String)> = Vec::new();
     let mut area = 0.0;
-    let (mut vlo, mut vhi, mut plo, mut phi_hi) = (
+    let (mut vlo, mut vhi, mut alo, mut ahi) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
         f64::INFINITY,
@@ -428,8 +464,8 @@ pub fn assemble(
             ends.push((k, l.value, i.hi, format!("{}/hi", i.hi_label)));
             vlo = vlo.min(l.value);
             vhi = vhi.max(l.value);
-            plo = plo.min(i.lo);
-            phi_hi = phi_hi.max(i.hi);
+            alo = alo.min(i.lo);
+            ahi = ahi.max(i.hi);
         }
         if k > 0 {
             area += 0.5 * (widths[k] + widths[k - 1]) * (l.value - lines[k - 1].value);
@@ -451,45 +487,46 @@ pub fn assemble(
     let mut bounding_box = BTreeMap::new();
     if vlo.is_finite() {
         bounding_box.insert(spec.parameter.name().to_string(), [vlo, vhi]);
-        bounding_box.insert("phi_over_2pi".to_string(), [plo, phi_hi]);
+        bounding_box.insert(along.name().to_string(), [alo, ahi]);
     }
     Map {
         scene: scene_name.into(),
         parameter: spec.parameter.name().into(),
+        along: along.name().into(),
         lines,
         boundaries,
         grid_boundaries,
         traced,
         grid,
-        grid_phi,
+        grid_along,
         good_area: area,
         bounding_box,
     }
 }
 
-/// Join interval ends (line index, parameter, φ/2π, "label/side") into
+/// Join interval ends (line index, parameter, value along, "label/side") into
 /// boundary curves: an end continues the curve of the same label and side
-/// whose last end lies on the previous line and is nearest in φ (within
+/// whose last end lies on the previous line and is nearest along it (within
 /// 0.05); otherwise it starts a new curve. A label with several curves is
-/// numbered along φ (X1, X2, … as in the paper).
+/// numbered along the lines (X1, X2, … as in the paper).
 fn chain_boundaries(ends: &[(usize, f64, f64, String)]) -> BTreeMap<String, Vec<[f64; 2]>> {
     let mut curves: Vec<(String, usize, Vec<[f64; 2]>)> = Vec::new(); // key, last line, points
     let mut sorted: Vec<&(usize, f64, f64, String)> = ends.iter().collect();
     sorted.sort_by(|a, b| (a.0, &a.3).cmp(&(b.0, &b.3)).then(a.2.total_cmp(&b.2)));
-    for &(line, value, phi, ref key) in sorted {
+    for &(line, value, x, ref key) in sorted {
         let best = curves
             .iter()
             .enumerate()
             .filter(|(_, c)| &c.0 == key && c.1 + 1 == line)
-            .map(|(i, c)| (i, (c.2.last().unwrap()[1] - phi).abs()))
+            .map(|(i, c)| (i, (c.2.last().unwrap()[1] - x).abs()))
             .filter(|&(_, d)| d <= 0.05)
             .min_by(|a, b| a.1.total_cmp(&b.1));
         match best {
             Some((i, _)) => {
                 curves[i].1 = line;
-                curves[i].2.push([value, phi]);
+                curves[i].2.push([value, x]);
             }
-            None => curves.push((key.clone(), line, vec![[value, phi]])),
+            None => curves.push((key.clone(), line, vec![[value, x]])),
         }
     }
     let mut named: BTreeMap<String, Vec<Vec<[f64; 2]>>> = BTreeMap::new();
@@ -512,15 +549,17 @@ fn chain_boundaries(ends: &[(usize, f64, f64, String)]) -> BTreeMap<String, Vec<
     out
 }
 
-/// Class of a line at each grid φ: the stable state if several, else the first.
-fn grid_row(l: &Line, phis: &[f64]) -> Vec<Class> {
-    phis.iter()
-        .map(|&phi| {
+/// Class of a line at each grid column: the stable state if several, else
+/// the first.
+fn grid_row(l: &Line, columns: &[f64]) -> Vec<Class> {
+    columns
+        .iter()
+        .map(|&x| {
             let mut found: Option<Class> = None;
             for w in l.points.windows(2) {
-                let (a, b) = (w[0].phi_over_2pi, w[1].phi_over_2pi);
-                if (a - phi) * (b - phi) <= 0.0 && a != b {
-                    let c = if (phi - a).abs() <= (phi - b).abs() {
+                let (a, b) = (w[0].along, w[1].along);
+                if (a - x) * (b - x) <= 0.0 && a != b {
+                    let c = if (x - a).abs() <= (x - b).abs() {
                         w[0].class
                     } else {
                         w[1].class
@@ -563,7 +602,7 @@ pub fn grid_check(traced: &Traced, lines: &[Line]) -> Option<GridCheck> {
     }
     Some(GridCheck {
         ends,
-        max_phi_deviation: worst,
+        max_deviation: worst,
         lines_with_other_count: other,
     })
 }

@@ -1,6 +1,7 @@
 //! Figure 9: the good knots of the strip in (δ, z*, φ), one island map per
 //! slice of δ.
 
+use crate::model::rod::Parameter;
 use crate::report::error::{Context, Result};
 use crate::scene::Scene;
 use crate::scene::SliceSpec;
@@ -26,7 +27,7 @@ fn map3_table(scenes: &Path) -> Result<String> {
         .clone()
         .context("fig9 scene has no [map.slices]")?;
     let cont = scene.continuation.as_ref().context("no [continuation]")?;
-    let m3 = slice_maps(&scene, &slices, cont.range)?;
+    let m3 = slice_maps(&scene, &slices, cont.parameter, cont.range)?;
     let mut s = String::new();
     writeln!(
         s,
@@ -52,7 +53,12 @@ fn map3_table(scenes: &Path) -> Result<String> {
 }
 
 /// Each slice's island map (grid and traced boundary), assembled in 3D.
-fn slice_maps(scene: &Scene, slices: &SliceSpec, phi_range: [f64; 2]) -> Result<Map3> {
+fn slice_maps(
+    scene: &Scene,
+    slices: &SliceSpec,
+    along: Parameter,
+    range: [f64; 2],
+) -> Result<Map3> {
     let mut maps = Vec::new();
     for k in 0..slices.values.len() {
         let slice = slices.scene(scene, k);
@@ -73,7 +79,8 @@ fn slice_maps(scene: &Scene, slices: &SliceSpec, phi_range: [f64; 2]) -> Result<
         maps.push(crate::study::map::assemble(
             "fig9",
             &sspec,
-            phi_range,
+            along,
+            range,
             lines,
             Some(traced),
         ));
@@ -113,7 +120,7 @@ fn slice_table(m3: &Map3) -> Result<String> {
             .as_ref()
             .and_then(|t| t.grid_check.as_ref())
             .map_or("—".to_string(), |g| {
-                format!("{:.1e} ({} ends)", g.max_phi_deviation, g.ends)
+                format!("{:.1e} ({} ends)", g.max_deviation, g.ends)
             });
         writeln!(
             s,

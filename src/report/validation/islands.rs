@@ -1,6 +1,7 @@
 //! Figure 7: the islands of good knots, the grid of lines against the
 //! boundary traced by two-parameter continuation.
 
+use crate::model::rod::Parameter;
 use crate::report::error::{Context, Result};
 use crate::scene::MapSpec;
 use crate::scene::Scene;
@@ -48,7 +49,7 @@ fn island_table(scenes: &Path, name: &str, paper: &[&str]) -> Result<String> {
         .continuation
         .as_ref()
         .context("fig7 scene has no [continuation]")?;
-    let map = island_map(&scene, &spec, name, cont.range)?;
+    let map = island_map(&scene, &spec, name, cont.parameter, cont.range)?;
     let mut s = grid_table(&scene, &spec, &map, name)?;
     if let Some(t) = &map.traced {
         s += &traced_comparison(&scene, &spec, &map, t, paper)?;
@@ -58,7 +59,13 @@ fn island_table(scenes: &Path, name: &str, paper: &[&str]) -> Result<String> {
 
 /// The map as `knotrod map` computes it: the grid of lines and the traced
 /// boundary.
-fn island_map(scene: &Scene, spec: &MapSpec, name: &str, phi_range: [f64; 2]) -> Result<Map> {
+fn island_map(
+    scene: &Scene,
+    spec: &MapSpec,
+    name: &str,
+    along: Parameter,
+    range: [f64; 2],
+) -> Result<Map> {
     let cache =
         std::env::temp_dir().join(format!("knotrod-validate-island-{}", std::process::id()));
     let indices: Vec<usize> = (0..spec.lines).collect();
@@ -75,7 +82,8 @@ fn island_map(scene: &Scene, spec: &MapSpec, name: &str, phi_range: [f64; 2]) ->
     Ok(crate::study::map::assemble(
         name,
         spec,
-        phi_range,
+        along,
+        range,
         lines,
         Some(traced),
     ))
@@ -302,7 +310,7 @@ fn traced_extent(t: &Traced) -> Result<String> {
             s,
             "Check against the grid: {} interval ends of the lines the loop spans lie within {:.1e} in φ/2π of the loop's crossings of those lines (chords of the traced polyline against bisected events); lines where the loop and the grid count different ends: {}.",
             g.ends,
-            g.max_phi_deviation,
+            g.max_deviation,
             if g.lines_with_other_count.is_empty() {
                 "none".to_string()
             } else {

@@ -1,5 +1,6 @@
 //! The boundary of the island of good knots traced directly in the plane of
-//! two clamp parameters (the map's swept parameter, φ/2π). Each boundary is a
+//! two parameters (the map's swept parameter, and the continuation's along
+//! the lines: φ/2π for the paper's maps). Each boundary is a
 //! codimension-one condition on the equilibria, zero on the curve and
 //! positive on the good side:
 //! - a wall touched: the smaller of the lowest interior node height (z = 0)

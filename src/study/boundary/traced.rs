@@ -6,8 +6,9 @@ use crate::study::boundary::condition::Condition;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// A piece of the walk: its condition, and its points with the φ component
-/// of the condition's unit gradient (positive: the good side lies above).
+/// A piece of the walk: its condition, and its points with the component
+/// along the lines (the continuation's parameter) of the condition's unit
+/// gradient (positive: the good side lies above).
 pub(super) type Trail = (Condition, Vec<([f64; 2], f64)>);
 
 /// One piece of the traced boundary: a polyline on one condition.
@@ -17,7 +18,8 @@ pub struct Piece {
     pub label: String,
     /// The condition followed.
     pub condition: String,
-    /// Points (swept parameter, φ/2π) in walk order (good region on the left).
+    /// Points (swept parameter, value along) in walk order (good region on
+    /// the left).
     pub points: Vec<[f64; 2]>,
 }
 
@@ -26,8 +28,10 @@ pub struct Piece {
 pub struct GridCheck {
     /// Grid interval ends compared (lines whose value the loop spans).
     pub ends: usize,
-    /// Largest |φ/2π(grid end) − φ/2π(nearest boundary crossing of that line)|.
-    pub max_phi_deviation: f64,
+    /// Largest |grid end − nearest boundary crossing of that line|, in the
+    /// parameter along the lines.
+    #[serde(alias = "max_phi_deviation")]
+    pub max_deviation: f64,
     /// Lines where the loop and the grid count different interval ends.
     pub lines_with_other_count: Vec<f64>,
 }
@@ -41,7 +45,8 @@ pub struct Traced {
     pub closed: bool,
     /// Area enclosed (closed walks only).
     pub area: Option<f64>,
-    /// Extent of the traced boundary: {parameter: [lo, hi], "phi_over_2pi": [lo, hi]}.
+    /// Extent of the traced boundary: {swept: [lo, hi], along: [lo, hi]},
+    /// keyed by the parameters' names.
     pub bounding_box: BTreeMap<String, [f64; 2]>,
     /// Points of the pieces (a corner counts in both its pieces).
     pub points: usize,
@@ -60,7 +65,8 @@ impl Traced {
         self.pieces.iter().flat_map(|p| p.points.clone()).collect()
     }
 
-    /// φ/2π where the traced loop crosses the line (swept parameter = v).
+    /// Values along the lines where the traced loop crosses the line
+    /// (swept parameter = v).
     pub fn cuts(&self, v: f64) -> Vec<f64> {
         self.polygon()
             .windows(2)
@@ -93,7 +99,7 @@ fn same_crossing(a: &Condition, b: &Condition) -> bool {
 }
 
 /// The paper's name of a piece: walls are W1 where the good region lies
-/// above them in φ, W2 where it lies below.
+/// above them along the lines (in φ for the paper), W2 where it lies below.
 fn label(c: &Condition, side: f64) -> &'static str {
     match c {
         Condition::Wall if side >= 0.0 => "W1",
@@ -105,7 +111,7 @@ fn label(c: &Condition, side: f64) -> &'static str {
 
 /// Name the pieces as the paper does and measure the loop.
 pub(super) fn name_pieces(
-    swept: Parameter,
+    [swept, along]: [Parameter; 2],
     equilibria: usize,
     pieces: Vec<Trail>,
     closed: bool,
@@ -153,7 +159,8 @@ pub(super) fn name_pieces(
             .points
             .extend(first.points.into_iter().skip(1));
     }
-    // several pieces of one name are numbered along φ (X1, X2 as in the paper)
+    // several pieces of one name are numbered along the lines (X1, X2 as in
+    // the paper)
     let mut by_label: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     for (k, p) in named.iter().enumerate() {
         by_label.entry(p.label.clone()).or_default().push(k);
@@ -191,7 +198,7 @@ pub(super) fn name_pieces(
             .abs()
     });
     if !all.is_empty() {
-        for (k, name) in [swept.name(), "phi_over_2pi"].into_iter().enumerate() {
+        for (k, name) in [swept.name(), along.name()].into_iter().enumerate() {
             let lo = all.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
             let hi = all.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
             traced.bounding_box.insert(name.to_string(), [lo, hi]);
@@ -223,7 +230,7 @@ mod tests {
                 vec![([0.2, 0.6], 0.1), ([0.3, 0.8], 0.1), ([0.2, 0.9], 0.1)],
             ),
         ];
-        let t = name_pieces(Parameter::ZStar, 7, trail, true, None);
+        let t = name_pieces([Parameter::ZStar, Parameter::Phi], 7, trail, true, None);
         let labels: Vec<&str> = t.pieces.iter().map(|p| p.label.as_str()).collect();
         // the walk's first piece (W2 from the start) joins its last (W2 back to
         // the start) only when they share a name; here S closes the loop

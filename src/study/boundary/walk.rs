@@ -51,10 +51,21 @@ struct Walk<'t, 'a> {
     tracer: &'t mut Tracer<'a>,
     measure: Measure,
     base: Clamps,
+    /// The map's parameter (p[0]) and the continuation's along its lines (p[1]).
     swept: Parameter,
+    along: Parameter,
     bounds: [[f64; 2]; 2],
     max_step: f64,
     equilibria: usize,
+}
+
+/// A parameter in messages: φ as the paper writes it, others by their name.
+fn label(p: Parameter) -> &'static str {
+    if p == Parameter::Phi {
+        "φ/2π"
+    } else {
+        p.name()
+    }
 }
 
 fn unit(v: [f64; 2]) -> [f64; 2] {
@@ -77,8 +88,7 @@ fn left_tangent(gradient: [f64; 2]) -> [f64; 2] {
 
 impl Walk<'_, '_> {
     fn clamps(&self, p: [f64; 2]) -> Clamps {
-        self.swept
-            .with(&Parameter::Phi.with(&self.base, p[1]), p[0])
+        self.swept.with(&self.along.with(&self.base, p[1]), p[0])
     }
 
     /// The equilibrium at `p`, continued from the one at `from` in moves of at
@@ -108,9 +118,10 @@ impl Walk<'_, '_> {
                 .settle_at(start, self.clamps(q))
                 .with_context(|| {
                     format!(
-                        "equilibrium at {} = {:.6}, φ/2π = {:.6}",
-                        self.swept.name(),
+                        "equilibrium at {} = {:.6}, {} = {:.6}",
+                        label(self.swept),
                         q[0],
+                        label(self.along),
                         q[1]
                     )
                 })?;
@@ -349,8 +360,8 @@ struct Step {
 }
 
 /// Trace the boundary of the good region of `scene`'s map from the scene's
-/// start, which must be a good knot: move up in φ to the first boundary, then
-/// walk around the region.
+/// start, which must be a good knot: move up in the continuation's parameter
+/// to the first boundary, then walk around the region.
 pub fn trace_island(
     scene: &Scene,
     spec: &MapSpec,
@@ -360,29 +371,43 @@ pub fn trace_island(
     let cont = scene
         .continuation
         .as_ref()
-        .context("[map] needs a [continuation] in φ")?;
-    if spec.parameter == Parameter::Phi {
-        fail!("map.parameter: the boundary is traced in (parameter, φ); it cannot be φ");
+        .context("[map] needs a [continuation] giving the branches")?;
+    let (swept, along) = (spec.parameter, cont.parameter);
+    if swept == along {
+        fail!(
+            "map.parameter: the boundary is traced in (map.parameter, continuation.parameter); \
+             both are {}",
+            swept.name()
+        );
     }
     let (mut newton, state, _) = starting_equilibrium(scene, segments)?;
-    let mut tracer = Tracer::new(&mut newton, Parameter::Phi, cont.settings());
+    let mut tracer = Tracer::new(&mut newton, along, cont.settings());
     let base = state.clamps;
     let mut walk = Walk {
         tracer: &mut tracer,
         measure: scene.measure(),
         base,
-        swept: spec.parameter,
+        swept,
+        along,
         bounds: [spec.range, cont.range],
         max_step: spec.trace_step,
         equilibria: 0,
     };
-    let p0 = [spec.parameter.value(&base), base.phi_over_2pi()];
+    let p0 = [swept.value(&base), along.value(&base)];
+    if !p0.iter().all(|v| v.is_finite()) {
+        fail!(
+            "the boundary walk's start: the scene's start carries no value of {} or {}",
+            label(swept),
+            label(along)
+        );
+    }
     if !walk.inside(spec.trace_from.unwrap_or(p0)) {
         fail!(
-            "the boundary walk's start ({} = {}, φ/2π = {}: map.trace_from or the scene's \
+            "the boundary walk's start ({} = {}, {} = {}: map.trace_from or the scene's \
              start) lies outside the map's range",
-            spec.parameter.name(),
+            label(swept),
             spec.trace_from.unwrap_or(p0)[0],
+            label(along),
             spec.trace_from.unwrap_or(p0)[1]
         );
     }
@@ -401,9 +426,10 @@ pub fn trace_island(
     if let Some(f) = walk.failing(&start, None, [0.0, 0.0])? {
         fail!(
             "the boundary walk starts from a good knot (map.trace_from, or the scene's start); \
-             at {} = {}, φ/2π = {} {f}",
-            spec.parameter.name(),
+             at {} = {}, {} = {} {f}",
+            label(swept),
             p0[0],
+            label(along),
             p0[1]
         );
     }
@@ -412,7 +438,7 @@ pub fn trace_island(
     let stopped = outcome.err().map(|e| describe(&e));
     let closed = stopped.is_none();
     Ok(name_pieces(
-        walk.swept,
+        [swept, along],
         walk.equilibria,
         pieces,
         closed,
@@ -420,7 +446,8 @@ pub fn trace_island(
     ))
 }
 
-/// Walk round the good region from `start`: up in φ to the first boundary,
+/// Walk round the good region from `start`: up along the lines (p[1]) to
+/// the first boundary,
 /// then along each condition, turning at every corner, until the walk
 /// passes its start again.
 fn walk_around(
@@ -480,7 +507,8 @@ fn walk_around(
     }
 }
 
-/// The first boundary above the start in φ (bisected to it), its condition
+/// The first boundary above the start along the lines (bisected to it), its
+/// condition
 /// oriented positive on the good side, and the walk's first point on it.
 fn first_boundary(walk: &mut Walk, start: Site) -> Result<(Condition, Step)> {
     let up = [0.0, 1.0];
@@ -488,7 +516,10 @@ fn first_boundary(walk: &mut Walk, start: Site) -> Result<(Condition, Step)> {
     let bad = loop {
         let p = along(good.p, up, SUBSTEP);
         if !walk.inside(p) {
-            fail!("no boundary above the start within the map's φ range");
+            fail!(
+                "no boundary above the start within the range of {}",
+                label(walk.along)
+            );
         }
         let s = walk.equilibrium_at(&good, p)?;
         match walk.failing(&s, None, up)? {
@@ -704,7 +735,7 @@ mod tests {
 
     #[test]
     fn the_good_side_lies_to_the_left_of_the_walk() {
-        // good side towards +z* (gradient (1, 0)): walk towards −φ
+        // good side towards +z* (gradient (1, 0)): walk down along the lines
         assert_eq!(left_tangent([1.0, 0.0]), [0.0, -1.0]);
         let t = left_tangent([0.3, 0.4]);
         // left of t = (−t_y, t_x) points along the gradient
