@@ -263,3 +263,19 @@ fn the_command_writes_its_table_json_report_and_plot_and_refuses_bad_options() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn every_shipped_file_of_solutions_reads() {
+    let mut count = 0;
+    for entry in std::fs::read_dir("scenes/verify").unwrap() {
+        let path = entry.unwrap().path();
+        // a CSV names no scene: the Figure 3 branch's is Appendix D's
+        let scene = (path.extension().is_some_and(|e| e == "csv"))
+            .then_some(Path::new("scenes/appendix_d.toml"));
+        let (_, solutions) =
+            read_solutions(&path, scene).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(!solutions.is_empty());
+        count += 1;
+    }
+    assert!(count >= 5, "{count} files");
+}
