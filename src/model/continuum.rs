@@ -9,7 +9,7 @@
 
 use crate::model::energy::strip_energy;
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::central_jacobian;
+use crate::model::ode::{NewtonShootingFailure, newton_shooting};
 use crate::model::rod::{Clamps, EndKind, Law, RodModel};
 use crate::model::shooting::{OdeState, end_mismatch, rhs_loaded, start_frame};
 use crate::model::strip_shooting::{StripOdeState, sadowsky, strip_rhs};
@@ -371,57 +371,27 @@ impl Continuum {
     /// Newton shooting from `p` on the six s = 1 conditions (Jacobian by
     /// central differences, steps halved while the residual grows).
     pub fn polish(&self, p: &Unknowns) -> Result<Polished, ContinuumError> {
-        let mut p = *p;
-        let mut r = self.residual(&p)?;
+        self.residual(p)?;
         // a failed integration inside the Jacobian counts as an infinite residual
         let res = |q: &Vector6<f64>| {
             self.residual(q)
                 .unwrap_or_else(|_| Vector6::repeat(f64::INFINITY))
         };
-        for iteration in 0..NEWTON_ITERATIONS {
-            if r.norm() < NEWTON_TOL {
-                return Ok(Polished {
-                    unknowns: p,
-                    residual: r.norm(),
-                    iterations: iteration,
-                });
-            }
-            let dp = central_jacobian(&p, res)
-                .lu()
-                .solve(&(-r))
-                .filter(|d| d.iter().all(|v| v.is_finite()))
-                .ok_or(ContinuumError::Singular)?;
-            let mut t = 1.0;
-            let mut next = p + dp;
-            let mut rn = res(&next);
-            for _ in 0..12 {
-                if rn.norm().is_finite() && rn.norm() < r.norm() {
-                    break;
-                }
-                t *= 0.5;
-                next = p + t * dp;
-                rn = res(&next);
-            }
-            if !rn.norm().is_finite() {
-                return Err(ContinuumError::NotConverged {
-                    iterations: iteration + 1,
-                    residual: r.norm(),
-                });
-            }
-            p = next;
-            r = rn;
+        match newton_shooting(*p, res, NEWTON_TOL, NEWTON_ITERATIONS, 12) {
+            Ok((unknowns, residual, iterations)) => Ok(Polished {
+                unknowns,
+                residual,
+                iterations,
+            }),
+            Err(NewtonShootingFailure::Singular) => Err(ContinuumError::Singular),
+            Err(NewtonShootingFailure::NotConverged {
+                iterations,
+                residual,
+            }) => Err(ContinuumError::NotConverged {
+                iterations,
+                residual,
+            }),
         }
-        if r.norm() < NEWTON_TOL {
-            return Ok(Polished {
-                unknowns: p,
-                residual: r.norm(),
-                iterations: NEWTON_ITERATIONS,
-            });
-        }
-        Err(ContinuumError::NotConverged {
-            iterations: NEWTON_ITERATIONS,
-            residual: r.norm(),
-        })
     }
 }
 

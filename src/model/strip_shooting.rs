@@ -19,7 +19,7 @@
 use crate::linalg::jet;
 use crate::model::energy::{RodEnergy, strip_energy, vertex_strains};
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::{central_jacobian, hermite, rk4};
+use crate::model::ode::{NewtonShootingFailure, hermite, newton_shooting, rk4};
 use crate::model::rod::{Clamps, RodState};
 use crate::model::shooting::end_mismatch;
 use nalgebra::{Matrix2, SVector, Vector2, Vector3, Vector6};
@@ -288,43 +288,18 @@ impl StripProblem {
     /// central differences, as for the rod: a reference, not a solver), to a
     /// residual below 1e-11.
     pub fn refine(&self, start: StripUnknowns) -> Result<StripUnknowns, StripShootingError> {
-        let mut p = start.to_vector();
         let res = |p: &Vector6<f64>| self.residual(&StripUnknowns::from_vector(p));
-        let mut r = res(&p);
-        const ITERATIONS: usize = 30;
-        for _ in 0..ITERATIONS {
-            if r.norm() < 1e-11 {
-                return Ok(StripUnknowns::from_vector(&p));
-            }
-            let dp = central_jacobian(&p, res)
-                .lu()
-                .solve(&(-r))
-                .filter(|d| d.iter().all(|v| v.is_finite()))
-                .ok_or(StripShootingError::Singular)?;
-            // a step that makes the residual worse is halved (a few times):
-            // the law's Hessian can make full steps overshoot far from the
-            // solution, where the DER start may leave us
-            let mut t = 1.0;
-            let mut next = p + dp;
-            let mut rn = res(&next);
-            for _ in 0..8 {
-                if rn.norm().is_finite() && rn.norm() < r.norm() {
-                    break;
-                }
-                t *= 0.5;
-                next = p + t * dp;
-                rn = res(&next);
-            }
-            p = next;
-            r = rn;
+        match newton_shooting(start.to_vector(), res, 1e-11, 30, 8) {
+            Ok((p, _, _)) => Ok(StripUnknowns::from_vector(&p)),
+            Err(NewtonShootingFailure::Singular) => Err(StripShootingError::Singular),
+            Err(NewtonShootingFailure::NotConverged {
+                iterations,
+                residual,
+            }) => Err(StripShootingError::NotConverged {
+                iterations,
+                residual,
+            }),
         }
-        if r.norm() < 1e-11 {
-            return Ok(StripUnknowns::from_vector(&p));
-        }
-        Err(StripShootingError::NotConverged {
-            iterations: ITERATIONS,
-            residual: r.norm(),
-        })
     }
 }
 

@@ -227,13 +227,7 @@ pub fn starting_equilibrium(
     scene: &Scene,
     segments: Option<usize>,
 ) -> Result<(Minimizer, RodState, SolveReport)> {
-    let model = scene.rod_model(segments);
-    let mut newton = Minimizer::new(RodEnergy::with_ends(
-        model.clone(),
-        Terms::ALL,
-        scene.clamps().ends,
-    ));
-    newton.contact = scene.contact_model();
+    let (model, mut newton) = minimizer(scene, segments);
     if scene.initial.shape == InitialShape::DoubleRing {
         // unfold the double ring quasi-statically: straight from its own
         // clamps (0, 0, 2π) to the scene's
@@ -331,12 +325,9 @@ fn check_start(scene: &Scene, energy: &RodEnergy, state: &RodState) -> Result<()
     Ok(())
 }
 
-/// The equilibrium nearest the scene's initial shape at N segments, by
-/// Newton's method on ∇E = 0 for a Kirchhoff rod (a saddle too: an unstable
-/// solution given as a start stays itself, where minimisation would leave
-/// it); by minimisation if Newton does not converge from there, and for the
-/// laws with the constraint u2 = 0 (their SQP).
-pub fn equilibrium_near_start(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
+/// The scene's model at N segments and the minimiser of its energy (with
+/// its contact, if any).
+fn minimizer(scene: &Scene, segments: Option<usize>) -> (RodModel, Minimizer) {
     let model = scene.rod_model(segments);
     let mut newton = Minimizer::new(RodEnergy::with_ends(
         model.clone(),
@@ -344,6 +335,16 @@ pub fn equilibrium_near_start(scene: &Scene, segments: Option<usize>) -> Result<
         scene.clamps().ends,
     ));
     newton.contact = scene.contact_model();
+    (model, newton)
+}
+
+/// The equilibrium nearest the scene's initial shape at N segments, by
+/// Newton's method on ∇E = 0 for a Kirchhoff rod (a saddle too: an unstable
+/// solution given as a start stays itself, where minimisation would leave
+/// it); by minimisation if Newton does not converge from there, and for the
+/// laws with the constraint u2 = 0 (their SQP).
+pub fn equilibrium_near_start(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
+    let (model, mut newton) = minimizer(scene, segments);
     let start = initial_state(scene, &model)?;
     check_start(scene, &newton.energy, &start)?;
     let mut state = start.clone();
