@@ -88,6 +88,34 @@ pub struct Event {
     /// scalars (a branch in a tilt or in K3): z*, δ and φ alone do not say where.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clamps: Option<Clamps>,
+    /// The event located again on the continuum branch, when asked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub continuum: Option<ContinuumEvent>,
+}
+
+/// An event located on the continuum branch (the Kirchhoff or strip
+/// equations integrated to a tolerance), beside the discrete rod's.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ContinuumEvent {
+    /// The branch's parameter.
+    pub parameter: Parameter,
+    /// Its value at the event (φ as φ/2π).
+    pub value: f64,
+    /// Estimated error of `value`: its change when the integrator's
+    /// tolerance falls a hundredfold, plus the last secant step.
+    pub error: f64,
+    /// The discrete rod's value less the continuum's (its discretisation
+    /// error at this N).
+    pub discrete_minus_continuum: f64,
+    /// Tw there.
+    pub twist: f64,
+    /// The shooting unknowns there.
+    pub unknowns: [f64; 6],
+    /// Arclengths of the touching extremum (a wall) or of the two crossing
+    /// strands.
+    pub arclengths: Vec<f64>,
+    /// Secant steps taken.
+    pub steps: usize,
 }
 
 impl Event {
@@ -103,6 +131,7 @@ impl Event {
             branch,
             detail,
             clamps: (!c.is_paper() || !c.scalars.is_unset()).then_some(*c),
+            continuum: None,
         }
     }
 

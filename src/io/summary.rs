@@ -237,6 +237,47 @@ fn print_comparison(
     Ok(())
 }
 
+/// The events located again on the continuum branch: the parameter there
+/// with its error estimate, beside the discrete rod's value.
+fn print_polished(events: &[Event], out: &mut impl Write) -> std::io::Result<()> {
+    let polished: Vec<(&Event, &crate::analysis::event::ContinuumEvent)> = events
+        .iter()
+        .filter_map(|e| e.continuum.as_ref().map(|c| (e, c)))
+        .collect();
+    let Some((_, first)) = polished.first() else {
+        return Ok(());
+    };
+    let name = match first.parameter {
+        Parameter::Phi => "φ/2π".to_string(),
+        p => p.name().to_string(),
+    };
+    writeln!(
+        out,
+        "events on the continuum branch (polished; discrete − continuum is the discrete rod's error):"
+    )?;
+    writeln!(
+        out,
+        "  {:<6} {:<13} {:>6} {:>16} {:>9} {:>13} {:>10}  arclengths",
+        "label", "kind", "branch", name, "± error", "discrete − c", "Tw"
+    )?;
+    for (e, c) in polished {
+        let s: Vec<String> = c.arclengths.iter().map(|s| format!("{s:.5}")).collect();
+        writeln!(
+            out,
+            "  {:<6} {:<13} {:>6} {:>16.12} {:>9.1e} {:>13.3e} {:>10.7}  {}",
+            e.label,
+            e.kind,
+            e.branch,
+            c.value,
+            c.error,
+            c.discrete_minus_continuum,
+            c.twist,
+            s.join(", ")
+        )?;
+    }
+    Ok(())
+}
+
 /// Events as a table.
 pub fn print_events(events: &[Event], out: &mut impl Write) -> std::io::Result<()> {
     if events.is_empty() {
@@ -255,6 +296,7 @@ pub fn print_events(events: &[Event], out: &mut impl Write) -> std::io::Result<(
             e.label, e.kind, e.branch, e.z_star, e.phi_over_2pi, e.twist, e.detail
         )?;
     }
+    print_polished(events, out)?;
     // general clamps: every coordinate that is not the paper's, per event
     let general: Vec<&Event> = events.iter().filter(|e| e.clamps.is_some()).collect();
     if let Some(first) = general.first().and_then(|e| e.clamps) {

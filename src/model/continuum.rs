@@ -9,11 +9,11 @@
 
 use crate::model::energy::strip_energy;
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::{NewtonShootingFailure, newton_shooting};
+use crate::model::ode::{NewtonShootingFailure, central_jacobian, newton_shooting};
 use crate::model::rod::{Clamps, EndKind, Law, RodModel};
 use crate::model::shooting::{OdeState, end_mismatch, rhs_loaded, start_frame};
 use crate::model::strip_shooting::{StripOdeState, sadowsky, strip_rhs};
-use nalgebra::{SVector, Vector3, Vector6};
+use nalgebra::{Matrix6, SVector, Vector3, Vector6};
 use ode_solvers::{Dop853, OutputType, System};
 use std::f64::consts::PI;
 
@@ -124,6 +124,10 @@ const NEWTON_ITERATIONS: usize = 40;
 const ROD: usize = 21;
 // the strip's state then ∫W ds and ∫ w g·r ds
 const STRIP: usize = 23;
+/// Steps of one integration before it counts as blown up.
+const MAX_STEPS: u32 = 20_000;
+// the rod's state (A.2) and its derivatives in the six unknowns
+const VARIATIONAL: usize = 19 * 7;
 
 struct Rhs<F>(F);
 
@@ -211,6 +215,97 @@ fn integrate<const D: usize>(
     Ok((end, dense, steps))
 }
 
+/// y at each of the increasing `stops` in (0, 1] of y' = f(s, y) from
+/// y(0) = `y0`, to `tolerance`: each piece is integrated afresh from the
+/// last stop, so every stop is a step's own end (no interpolation).
+pub(crate) fn integrate_stops<const D: usize>(
+    y0: SVector<f64, D>,
+    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+    tolerance: f64,
+    stops: &[f64],
+) -> Result<Vec<SVector<f64, D>>, ContinuumError> {
+    let mut y = ode_solvers::SVector::<f64, D>::from_column_slice(y0.as_slice());
+    let mut from = 0.0;
+    let mut out = Vec::with_capacity(stops.len());
+    for &to in stops {
+        if !(to >= from && to <= 1.0) {
+            return Err(ContinuumError::Integration {
+                s: from,
+                reason: format!("stop s = {to} is not in [{from}, 1]"),
+            });
+        }
+        if to > from {
+            // the crate's defaults, but a solution needing more than
+            // MAX_STEPS steps (some hundred suffice for a knot) has blown up
+            let mut solver = Dop853::from_param(
+                Rhs(&f),
+                from,
+                to,
+                to - from,
+                y,
+                tolerance,
+                tolerance,
+                0.9,
+                0.0,
+                0.333,
+                6.0,
+                to - from,
+                0.0,
+                MAX_STEPS,
+                1000,
+                OutputType::Sparse,
+            );
+            solver
+                .integrate()
+                .map_err(|e| ContinuumError::Integration {
+                    s: match e {
+                        ode_solvers::dop_shared::IntegrationError::MaxNumStepReached {
+                            x, ..
+                        }
+                        | ode_solvers::dop_shared::IntegrationError::StepSizeUnderflow { x }
+                        | ode_solvers::dop_shared::IntegrationError::StiffnessDetected { x } => x,
+                    },
+                    reason: e.to_string(),
+                })?;
+            y = *solver.y_out().last().ok_or(ContinuumError::Integration {
+                s: from,
+                reason: "no step".into(),
+            })?;
+            if y.iter().any(|v| !v.is_finite()) {
+                return Err(ContinuumError::Integration {
+                    s: to,
+                    reason: "the solution is not finite".into(),
+                });
+            }
+        }
+        out.push(SVector::from_column_slice(y.as_slice()));
+        from = to;
+    }
+    Ok(out)
+}
+
+fn check_finite(p: &Unknowns) -> Result<(), ContinuumError> {
+    match p.iter().position(|v| !v.is_finite()) {
+        Some(k) => Err(ContinuumError::NotFinite(k)),
+        None => Ok(()),
+    }
+}
+
+/// The centreline point and material frame at one s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// r(s).
+    pub r: Vector3<f64>,
+    /// d1(s).
+    pub d1: Vector3<f64>,
+    /// d2(s).
+    pub d2: Vector3<f64>,
+    /// d3(s) = r'(s).
+    pub d3: Vector3<f64>,
+    /// d3'(s) = r''(s).
+    pub curvature: Vector3<f64>,
+}
+
 fn part<const D: usize>(y: &SVector<f64, D>, k: usize) -> Vector3<f64> {
     Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
 }
@@ -263,66 +358,193 @@ impl Continuum {
         })
     }
 
+    /// The rod's state (A.2) at s = 0 from the unknowns n(0), m(0), then
+    /// ∫W ds and ∫ w g·r ds.
+    fn rod_start(&self, p: &Unknowns) -> SVector<f64, ROD> {
+        let mut y0 = SVector::<f64, ROD>::zeros();
+        y0.fixed_rows_mut::<19>(0)
+            .copy_from(&start_frame(&self.clamps));
+        for c in 0..6 {
+            y0[12 + c] = p[c];
+        }
+        y0
+    }
+
+    /// The rod's right-hand side with the energy density and the weight's
+    /// potential alongside.
+    fn rod_rhs(&self, s: f64, y: &SVector<f64, ROD>, k2: f64, k3: f64) -> SVector<f64, ROD> {
+        let core: OdeState = y.fixed_rows::<19>(0).into();
+        let mut dy = SVector::<f64, ROD>::zeros();
+        let natural = self.natural.vector_at(s);
+        dy.fixed_rows_mut::<19>(0)
+            .copy_from(&rhs_loaded(&core, k2, k3, &self.weight, &natural));
+        let m = part(y, 5);
+        dy[19] = 0.5 * (m[0] * m[0] + m[1] * m[1] / k2 + m[2] * m[2] / k3);
+        dy[20] = self.weight.dot(&part(y, 0));
+        dy
+    }
+
+    /// The strip's state at s = 0 from n(0), u1(0), m2(0), u3(0), and m(0).
+    fn strip_start(
+        &self,
+        p: &Unknowns,
+        regularisation: f64,
+    ) -> (SVector<f64, STRIP>, Vector3<f64>) {
+        let mut y0 = SVector::<f64, STRIP>::zeros();
+        let a0 = p[3] - self.natural.at(0.0)[0];
+        let (m13, _) = sadowsky(a0, p[5], regularisation);
+        let m0 = Vector3::new(m13[0], p[4], m13[1]);
+        y0[3] = 1.0;
+        y0[7] = 1.0;
+        y0[11] = 1.0;
+        for c in 0..3 {
+            y0[12 + c] = p[c];
+            y0[15 + c] = m0[c];
+        }
+        y0[18] = a0;
+        y0[19] = p[5];
+        (y0, m0)
+    }
+
+    /// The strip's right-hand side with the energy density and the weight's
+    /// potential alongside.
+    fn strip_rhs(
+        &self,
+        s: f64,
+        y: &SVector<f64, STRIP>,
+        regularisation: f64,
+    ) -> SVector<f64, STRIP> {
+        let core: StripOdeState = y.fixed_rows::<21>(0).into();
+        let mut dy = SVector::<f64, STRIP>::zeros();
+        dy.fixed_rows_mut::<21>(0).copy_from(&strip_rhs(
+            s,
+            &core,
+            regularisation,
+            &self.weight,
+            &self.natural,
+        ));
+        dy[21] = strip_energy(y[18], y[19], regularisation, 1.0);
+        dy[22] = self.weight.dot(&part(y, 0));
+        dy
+    }
+
     /// Integrate from `p`, with r(s) at `samples` points if `samples` ≥ 2.
     pub fn solve(&self, p: &Unknowns, samples: usize) -> Result<ContinuumSolution, ContinuumError> {
-        if let Some(k) = p.iter().position(|v| !v.is_finite()) {
-            return Err(ContinuumError::NotFinite(k));
-        }
-        let w = self.weight;
+        check_finite(p)?;
         match self.law {
             ContinuumLaw::Kirchhoff { k2, k3 } => {
-                let mut y0 = SVector::<f64, ROD>::zeros();
-                let frame = start_frame(&self.clamps);
-                y0.fixed_rows_mut::<19>(0).copy_from(&frame);
-                for c in 0..6 {
-                    y0[12 + c] = p[c];
-                }
-                let f = |s: f64, y: &SVector<f64, ROD>| {
-                    let core: OdeState = y.fixed_rows::<19>(0).into();
-                    let mut dy = SVector::<f64, ROD>::zeros();
-                    let natural = self.natural.vector_at(s);
-                    dy.fixed_rows_mut::<19>(0)
-                        .copy_from(&rhs_loaded(&core, k2, k3, &w, &natural));
-                    let m = part(y, 5);
-                    dy[19] = 0.5 * (m[0] * m[0] + m[1] * m[1] / k2 + m[2] * m[2] / k3);
-                    dy[20] = w.dot(&part(y, 0));
-                    dy
-                };
-                let solved = integrate(y0, f, self.tolerance, samples)?;
+                let f = |s: f64, y: &SVector<f64, ROD>| self.rod_rhs(s, y, k2, k3);
+                let solved = integrate(self.rod_start(p), f, self.tolerance, samples)?;
                 Ok(self.solution(p, p.fixed_rows::<3>(3).into(), solved, 18))
             }
             ContinuumLaw::Strip { regularisation } => {
-                let mut y0 = SVector::<f64, STRIP>::zeros();
-                let a0 = p[3] - self.natural.at(0.0)[0];
-                let (m13, _) = sadowsky(a0, p[5], regularisation);
-                let m0 = Vector3::new(m13[0], p[4], m13[1]);
-                y0[3] = 1.0;
-                y0[7] = 1.0;
-                y0[11] = 1.0;
-                for c in 0..3 {
-                    y0[12 + c] = p[c];
-                    y0[15 + c] = m0[c];
-                }
-                y0[18] = a0;
-                y0[19] = p[5];
-                let f = |s: f64, y: &SVector<f64, STRIP>| {
-                    let core: StripOdeState = y.fixed_rows::<21>(0).into();
-                    let mut dy = SVector::<f64, STRIP>::zeros();
-                    dy.fixed_rows_mut::<21>(0).copy_from(&strip_rhs(
-                        s,
-                        &core,
-                        regularisation,
-                        &w,
-                        &self.natural,
-                    ));
-                    dy[21] = strip_energy(y[18], y[19], regularisation, 1.0);
-                    dy[22] = w.dot(&part(y, 0));
-                    dy
-                };
+                let (y0, m0) = self.strip_start(p, regularisation);
+                let f = |s: f64, y: &SVector<f64, STRIP>| self.strip_rhs(s, y, regularisation);
                 let solved = integrate(y0, f, self.tolerance, samples)?;
                 Ok(self.solution(p, m0, solved, 20))
             }
         }
+    }
+
+    /// The centreline and material frame at each of the increasing `stops`
+    /// in [0, 1], from `p`.
+    pub fn frames_at(&self, p: &Unknowns, stops: &[f64]) -> Result<Vec<Frame>, ContinuumError> {
+        check_finite(p)?;
+        let frame = |y: &[f64], dy: &[f64]| Frame {
+            r: Vector3::from_column_slice(&y[0..3]),
+            d1: Vector3::from_column_slice(&y[3..6]),
+            d2: Vector3::from_column_slice(&y[6..9]),
+            d3: Vector3::from_column_slice(&y[9..12]),
+            curvature: Vector3::from_column_slice(&dy[9..12]),
+        };
+        Ok(match self.law {
+            ContinuumLaw::Kirchhoff { k2, k3 } => {
+                let f = |s: f64, y: &SVector<f64, ROD>| self.rod_rhs(s, y, k2, k3);
+                let ys = integrate_stops(self.rod_start(p), f, self.tolerance, stops)?;
+                ys.iter()
+                    .zip(stops)
+                    .map(|(y, &s)| frame(y.as_slice(), f(s, y).as_slice()))
+                    .collect()
+            }
+            ContinuumLaw::Strip { regularisation } => {
+                let f = |s: f64, y: &SVector<f64, STRIP>| self.strip_rhs(s, y, regularisation);
+                let y0 = self.strip_start(p, regularisation).0;
+                let ys = integrate_stops(y0, f, self.tolerance, stops)?;
+                ys.iter()
+                    .zip(stops)
+                    .map(|(y, &s)| frame(y.as_slice(), f(s, y).as_slice()))
+                    .collect()
+            }
+        })
+    }
+
+    /// The s = 1 residual and its Jacobian in the unknowns. For a rod, the
+    /// Jacobian comes from the variational equations integrated with the
+    /// solution (the right-hand side of (A.2) is quadratic in the state, so
+    /// its directional derivative is an exact central difference); for a
+    /// strip, from central differences of whole integrations.
+    pub fn linearise(&self, p: &Unknowns) -> Result<(Vector6<f64>, Matrix6<f64>), ContinuumError> {
+        check_finite(p)?;
+        let ContinuumLaw::Kirchhoff { k2, k3 } = self.law else {
+            let r = self.residual(p)?;
+            let res = |q: &Unknowns| {
+                self.residual(q)
+                    .unwrap_or_else(|_| Vector6::repeat(f64::NAN))
+            };
+            let jac = central_jacobian(p, res);
+            if jac.iter().any(|v| !v.is_finite()) {
+                return Err(ContinuumError::Singular);
+            }
+            return Ok((r, jac));
+        };
+        let mut y0 = SVector::<f64, VARIATIONAL>::zeros();
+        y0.fixed_rows_mut::<19>(0)
+            .copy_from(&start_frame(&self.clamps));
+        for c in 0..6 {
+            y0[12 + c] = p[c];
+            // ∂y(0)/∂p_c: the unit vector of n(0) or m(0)'s component c
+            y0[19 * (c + 1) + 12 + c] = 1.0;
+        }
+        let f = |s: f64, y: &SVector<f64, VARIATIONAL>| {
+            let natural = self.natural.vector_at(s);
+            let rhs = |y: &OdeState| rhs_loaded(y, k2, k3, &self.weight, &natural);
+            let core: OdeState = y.fixed_rows::<19>(0).into();
+            let mut dy = SVector::<f64, VARIATIONAL>::zeros();
+            dy.fixed_rows_mut::<19>(0).copy_from(&rhs(&core));
+            for c in 1..7 {
+                let delta: OdeState = y.fixed_rows::<19>(19 * c).into();
+                // exact for a quadratic right-hand side at any scale of δ;
+                // the scale keeps round-off relative to |y|
+                let scale = 1.0 / delta.norm().max(1.0);
+                let jd =
+                    (rhs(&(core + scale * delta)) - rhs(&(core - scale * delta))) / (2.0 * scale);
+                dy.fixed_rows_mut::<19>(19 * c).copy_from(&jd);
+            }
+            dy
+        };
+        let end = integrate_stops(y0, f, self.tolerance, &[1.0])?[0];
+        let core: OdeState = end.fixed_rows::<19>(0).into();
+        let residual_of = |y: &OdeState| {
+            self.end_residual(
+                [part(y, 0), part(y, 1), part(y, 3)],
+                (part(y, 4), part(y, 5)),
+            )
+        };
+        let r = residual_of(&core);
+        let mut jac = Matrix6::zeros();
+        for c in 0..6 {
+            let delta: OdeState = end.fixed_rows::<19>(19 * (c + 1)).into();
+            // the s = 1 conditions are smooth functions of the end state:
+            // their derivative along ∂y(1)/∂p_c by central differences
+            let h = 1e-6 / delta.norm().max(1e-300);
+            let col =
+                (residual_of(&(core + h * delta)) - residual_of(&(core - h * delta))) / (2.0 * h);
+            jac.set_column(c, &col);
+        }
+        if jac.iter().any(|v| !v.is_finite()) {
+            return Err(ContinuumError::Singular);
+        }
+        Ok((r, jac))
     }
 
     /// The solution from an integration whose state holds r, d1, d2, d3, n,
@@ -348,7 +570,7 @@ impl Continuum {
         }
     }
 
-    fn end_residual(
+    pub(crate) fn end_residual(
         &self,
         rd: [Vector3<f64>; 3],
         (n1, m1): (Vector3<f64>, Vector3<f64>),
@@ -462,6 +684,19 @@ mod tests {
             assert!((r - arc).norm() < 1e-11, "{k}: {}", (r - arc).norm());
         }
         assert_eq!(sol.centreline.len(), 11);
+    }
+
+    #[test]
+    fn the_variational_jacobian_is_the_difference_quotient() {
+        // with a weight and natural strains, which keep (A.2) quadratic
+        let (mut c, p) = appendix_d();
+        c.weight = Vector3::new(0.3, -0.2, 1.5);
+        c.natural = NaturalStrains::Constant([0.4, -0.3, 0.2]);
+        let (r, jac) = c.linearise(&p).unwrap();
+        assert!((r - c.residual(&p).unwrap()).norm() < 1e-10);
+        let fd = central_jacobian(&p, |q| c.residual(q).unwrap());
+        let err = (jac - fd).norm() / jac.norm();
+        assert!(err < 1e-7, "relative difference {err:.2e}");
     }
 
     #[test]

@@ -410,6 +410,14 @@ pub struct ContinuationSpec {
     /// Most points per direction.
     #[serde(default)]
     pub max_points: Option<i64>,
+    /// Stop following a direction at the first event of one of these kinds
+    /// (e.g. ["fold"]: from the start to the first fold).
+    #[serde(default)]
+    pub stop_at: Vec<crate::analysis::event::EventKind>,
+    /// Locate every event again on the continuum branch (shooting with an
+    /// adaptive eighth-order integrator) and report both answers.
+    #[serde(default)]
+    pub polish: bool,
 }
 
 impl ContinuationSpec {

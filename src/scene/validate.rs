@@ -578,6 +578,13 @@ impl Scene {
             {
                 return Err(invalid("continuation.max_points", "must be >= 1"));
             }
+            if c.polish && (self.contact.is_some() || !self.loading.is_empty()) {
+                return Err(invalid(
+                    "continuation.polish",
+                    "the continuum equations have no contact and no loading path: \
+                     polish a contact-free branch",
+                ));
+            }
         }
         Ok(())
     }

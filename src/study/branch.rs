@@ -85,6 +85,8 @@ pub struct BranchOptions {
     pub switch_branches: bool,
     /// What to measure at each point.
     pub measure: Measure,
+    /// A direction stops at the first event of one of these kinds.
+    pub stop_at: Vec<EventKind>,
 }
 
 /// Traces branches and collects events.
@@ -94,6 +96,8 @@ pub struct BranchRun<'a, 'r> {
     observer: &'r mut Observer<'r>,
     /// Located events, in the order found.
     pub events: Vec<Event>,
+    /// The equilibrium at each located event (`events[k]` at `located[k]`).
+    pub located: Vec<RodState>,
     /// Branch points found (point, null vector), to switch onto.
     branch_points: Vec<(Point, Vec<f64>, usize)>,
     next_branch: usize,
@@ -118,6 +122,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             options,
             observer,
             events: Vec::new(),
+            located: Vec::new(),
             branch_points: Vec::new(),
             next_branch: first_branch,
             previous: None,
@@ -148,6 +153,12 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         eq.leg = leg;
         self.previous = Some(eq.clone());
         Ok(eq)
+    }
+
+    /// Keep an event at point `p` with its equilibrium.
+    fn record(&mut self, kind: EventKind, p: &Point, branch: usize, detail: String) {
+        self.events.push(event(kind, p, branch, detail));
+        self.located.push(p.state.clone());
     }
 
     fn in_range(&self, p: &Point) -> bool {
@@ -188,12 +199,12 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                     match self.tracer.correct(&fake, self.options.settings.step, None) {
                         Ok(p) if self.in_range(&p) => self.trace(p, b, 0, true)?,
                         Ok(_) => {}
-                        Err(e) => self.events.push(event(
+                        Err(e) => self.record(
                             EventKind::End,
                             &bp,
                             b,
                             format!("branch switch failed: {e}"),
-                        )),
+                        ),
                     }
                 }
             }
@@ -224,12 +235,12 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 }
                 _ => {
                     if !step.shrink() {
-                        self.events.push(event(
+                        self.record(
                             EventKind::End,
                             &a,
                             branch,
                             "step below min_step: branch lost".into(),
-                        ));
+                        );
                         break;
                     }
                     continue;
@@ -237,10 +248,17 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             };
             let eq = self.measure(&b, branch, leg)?;
             let wb = TestValues::of(&eq, &self.options.measure);
+            let found = self.events.len();
             if self.options.locate_events {
                 self.locate_events(&a, &b, &wa, &wb, step.length, branch)?;
             }
             (self.observer)(eq)?;
+            if self.events[found..]
+                .iter()
+                .any(|e| self.options.stop_at.contains(&e.kind))
+            {
+                break;
+            }
             step.accepted(b.iterations);
             a = b;
             wa = wb;
@@ -306,10 +324,9 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             // φ, Tw, walls): a symmetric branch point, not a fold
             let detail =
                 format!("{detail}; through a symmetric branch point onto the mirror branch");
-            self.events
-                .push(event(EventKind::BranchPoint, &p, branch, detail));
+            self.record(EventKind::BranchPoint, &p, branch, detail);
         } else {
-            self.events.push(event(EventKind::Fold, &p, branch, detail));
+            self.record(EventKind::Fold, &p, branch, detail);
         }
         Ok(())
     }
@@ -329,16 +346,15 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             .locate(a, ds, &mut |_, p| p.negative_count == na)
             .context("locating a change of stability")?;
         let detail = format!("negative eigenvalues {} → {}", na, b.negative_count);
-        self.events
-            .push(event(EventKind::Stability, &p, branch, detail.clone()));
+        self.record(EventKind::Stability, &p, branch, detail.clone());
         if !fold {
             let (lambda, null) = self.tracer.lowest_mode(&p)?;
-            self.events.push(event(
+            self.record(
                 EventKind::BranchPoint,
                 &p,
                 branch,
                 format!("{detail}; eigenvalue there {lambda:.2e}"),
-            ));
+            );
             self.branch_points.push((p, null, branch));
         }
         Ok(())
@@ -358,8 +374,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         } else {
             "enters the walls"
         };
-        self.events
-            .push(event(EventKind::Wall, &p, branch, detail.into()));
+        self.record(EventKind::Wall, &p, branch, detail.into());
         Ok(())
     }
 
@@ -388,11 +403,9 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             wa.link,
             wb.link
         );
-        self.events
-            .push(event(EventKind::Crossing, &p, branch, detail.clone()));
+        self.record(EventKind::Crossing, &p, branch, detail.clone());
         if wa.knot != wb.knot {
-            self.events
-                .push(event(EventKind::KnotChange, &p, branch, detail));
+            self.record(EventKind::KnotChange, &p, branch, detail);
         }
         Ok(())
     }
@@ -420,8 +433,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         } else {
             "the ribbon touches itself"
         };
-        self.events
-            .push(event(EventKind::Crossing, &p, branch, detail.into()));
+        self.record(EventKind::Crossing, &p, branch, detail.into());
         Ok(())
     }
 

@@ -369,6 +369,7 @@ fn compute_line(
             eigenvalues: 0,
             ..scene.measure()
         },
+        stop_at: Vec::new(),
     };
     let mut eqs = Vec::new();
     let mut obs = |e: Equilibrium| {

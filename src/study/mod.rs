@@ -8,6 +8,7 @@ pub mod branch;
 pub mod error;
 pub mod loading;
 pub mod map;
+pub mod polish;
 pub mod run;
 pub mod start;
 pub mod verify;

@@ -115,6 +115,7 @@ pub fn run_scene(
         locate_events: spec.locate_events,
         switch_branches: spec.switch_branches,
         measure,
+        stop_at: spec.stop_at.clone(),
     };
     let directions: &[f64] = match spec.direction {
         Direction::Up => &[1.0],
@@ -125,6 +126,7 @@ pub fn run_scene(
         Some(sw) => sw.values.iter().map(|v| Some((sw.parameter, *v))).collect(),
         None => vec![None],
     };
+    let newton_model = newton.energy.model.clone();
     let mut events = Vec::new();
     let mut first_branch = 0;
     for stop in stops {
@@ -135,6 +137,15 @@ pub fn run_scene(
         let mut run = BranchRun::new(&mut newton, options.clone(), &mut *observer, first_branch);
         run.follow(state.clone(), directions)?;
         first_branch = run.next_branch();
+        if spec.polish {
+            crate::study::polish::polish_events(
+                &newton_model,
+                spec.parameter,
+                &options.measure,
+                &mut run.events,
+                &run.located,
+            );
+        }
         events.extend(run.events);
     }
     label_events(&mut events);

@@ -809,24 +809,8 @@ pub fn shooting_unknowns(
     model: &crate::model::rod::RodModel,
     state: &crate::model::rod::RodState,
 ) -> Result<ShootingUnknowns> {
-    use crate::model::energy::{RodEnergy, Terms};
-    use crate::model::strip_shooting::StripUnknowns;
-    let energy = RodEnergy::with_ends(model.clone(), Terms::ALL, state.clamps.ends);
     let strip = matches!(model.law, Law::Strip { .. });
-    let discrete = if strip {
-        let p = StripUnknowns::from_der(&energy, state);
-        Unknowns::new(p.n0[0], p.n0[1], p.n0[2], p.u1, p.m2, p.u3)
-    } else {
-        let r = energy.clamp_reactions(state);
-        Unknowns::new(
-            r.force[0],
-            r.force[1],
-            r.force[2],
-            r.moment[0],
-            r.moment[1],
-            r.moment[2],
-        )
-    };
+    let discrete = crate::study::polish::discrete_unknowns(model, state);
     let continuum = Continuum::of(model, state.clamps, VerifyOptions::default().tolerance)?;
     let polished = continuum
         .polish(&discrete)

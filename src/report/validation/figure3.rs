@@ -33,6 +33,8 @@ fn figure_3_events(d: &Scene, n: usize) -> Result<Vec<crate::analysis::event::Ev
         step: None,
         max_step: None,
         max_points: None,
+        stop_at: Vec::new(),
+        polish: false,
     });
     Ok(crate::study::run::run_scene(&scene, Some(n), &mut |_| {
         Ok(())

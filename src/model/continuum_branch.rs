@@ -1,0 +1,474 @@
+//! The continuum branch through one parameter, and the points on it where a
+//! test function vanishes, located to the integrator's tolerance: the
+//! continuum polish of the discrete rod's events.
+//!
+//! A point of the branch is z = (p, λ): the six shooting unknowns and the
+//! parameter. It is corrected by Newton's method on the six s = 1 conditions
+//! with one coordinate of z held (λ itself, or at a fold an unknown along
+//! which the branch passes the fold), and an event is the root of a test
+//! function along the branch, found by the secant method (as AUTO-07p locates
+//! its special points): folds and branch points where the shooting Jacobian
+//! is singular (a bordered determinant), walls where an interior extremum of
+//! the height touches a wall, crossings where the signed distance of two
+//! strands vanishes.
+
+use crate::model::continuum::{Continuum, ContinuumError, Frame, Unknowns};
+use crate::model::rod::{Clamps, Parameter, RodModel};
+use nalgebra::{Matrix6, SMatrix, SVector, Vector3, Vector6};
+
+/// A point of the branch: the unknowns (0..6) and the parameter (6).
+pub type BranchPoint = SVector<f64, 7>;
+
+/// The coordinate of a [`BranchPoint`] that is the parameter.
+pub const PARAMETER: usize = 6;
+
+/// Corrector iterations before giving up.
+const CORRECTOR_ITERATIONS: usize = 30;
+/// A residual this many tolerances small that Newton cannot reduce is at
+/// the integrator's noise.
+const NOISE_FLOOR: f64 = 1e5;
+/// Secant steps before giving up.
+const SECANT_ITERATIONS: usize = 40;
+
+/// Why the continuum branch or an event on it could not be computed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum BranchError {
+    /// The continuum problem itself failed.
+    #[error(transparent)]
+    Continuum(#[from] ContinuumError),
+    /// The corrector did not converge.
+    #[error("continuum corrector: residual {residual:.2e} after {iterations} iterations")]
+    Corrector {
+        /// Iterations made.
+        iterations: usize,
+        /// The last residual.
+        residual: f64,
+    },
+    /// The test function did not change sign near the start, or the secant
+    /// method did not converge.
+    #[error("the test function's root was not found: {0}")]
+    NoRoot(String),
+}
+
+/// The family of continuum problems along one parameter.
+#[derive(Clone, Debug)]
+pub struct ContinuumBranch<'a> {
+    model: &'a RodModel,
+    clamps: Clamps,
+    parameter: Parameter,
+    /// Tolerance of the adaptive integrator.
+    pub tolerance: f64,
+}
+
+/// What vanishes at an event.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TestFunction {
+    /// The shooting Jacobian is singular (fold, branch point, change of
+    /// stability): the bordered determinant g of [[J, b], [cᵀ, 0]] [v; g] =
+    /// [0; 1], with b and c the left and right singular vectors of the
+    /// smallest singular value of J at the start.
+    Singular {
+        /// Border column b.
+        left: Vector6<f64>,
+        /// Border row c.
+        right: Vector6<f64>,
+    },
+    /// An interior extremum of the height (along the s = 0 clamp's tangent)
+    /// reaches `wall`; the extremum is sought near arclength `s`.
+    Wall {
+        /// The wall's height.
+        wall: f64,
+        /// Arclength of the extremum (updated as it moves).
+        s: f64,
+    },
+    /// Two strands of the centreline pass through each other: the signed
+    /// distance of their closest points, sought near arclengths `s`.
+    Crossing {
+        /// Arclengths of the two closest points (updated as they move).
+        s: [f64; 2],
+    },
+}
+
+/// An event located on the continuum branch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Located {
+    /// Where: the unknowns and the parameter.
+    pub point: BranchPoint,
+    /// The test function there (with its updated arclengths).
+    pub test: TestFunction,
+    /// Its value there.
+    pub value: f64,
+    /// Secant steps taken.
+    pub steps: usize,
+    /// The last secant step in the held coordinate.
+    pub last_step: f64,
+    /// The point before it.
+    pub previous: BranchPoint,
+}
+
+impl<'a> ContinuumBranch<'a> {
+    /// The branch of `model` through `clamps` in `parameter`, integrated to
+    /// `tolerance`.
+    pub fn new(
+        model: &'a RodModel,
+        clamps: Clamps,
+        parameter: Parameter,
+        tolerance: f64,
+    ) -> Result<Self, BranchError> {
+        Continuum::of(model, clamps, tolerance)?;
+        Ok(ContinuumBranch {
+            model,
+            clamps,
+            parameter,
+            tolerance,
+        })
+    }
+
+    /// The same branch at another tolerance.
+    pub fn with_tolerance(&self, tolerance: f64) -> Self {
+        ContinuumBranch {
+            tolerance,
+            ..self.clone()
+        }
+    }
+
+    /// The clamps at parameter value `value`.
+    pub fn clamps_at(&self, value: f64) -> Clamps {
+        self.parameter.with(&self.clamps, value)
+    }
+
+    /// The continuum problem at parameter value `value`.
+    pub fn problem(&self, value: f64) -> Result<Continuum, BranchError> {
+        Ok(Continuum::of(
+            self.model,
+            self.clamps_at(value),
+            self.tolerance,
+        )?)
+    }
+
+    /// The s = 1 residual at z and its Jacobian in all seven coordinates
+    /// (the parameter's column by central differences).
+    pub fn linearise(
+        &self,
+        z: &BranchPoint,
+    ) -> Result<(Vector6<f64>, SMatrix<f64, 6, 7>), BranchError> {
+        let p: Unknowns = z.fixed_rows::<6>(0).into();
+        let (r, jp) = self.problem(z[PARAMETER])?.linearise(&p)?;
+        let h = 1e-6 * (1.0 + z[PARAMETER].abs());
+        let plus = self.problem(z[PARAMETER] + h)?.residual(&p)?;
+        let minus = self.problem(z[PARAMETER] - h)?.residual(&p)?;
+        let mut jac = SMatrix::<f64, 6, 7>::zeros();
+        jac.fixed_columns_mut::<6>(0).copy_from(&jp);
+        jac.set_column(PARAMETER, &((plus - minus) / (2.0 * h)));
+        Ok((r, jac))
+    }
+
+    /// The unit tangent of the branch at z (the null vector of the 6×7
+    /// Jacobian), oriented along `towards` if given.
+    pub fn tangent(&self, z: &BranchPoint) -> Result<BranchPoint, BranchError> {
+        let (_, jac) = self.linearise(z)?;
+        null_vector(&jac).ok_or(BranchError::Continuum(ContinuumError::Singular))
+    }
+
+    /// Newton's method on the s = 1 conditions from `z` with coordinate
+    /// `held` fixed: the point of the branch there.
+    pub fn correct(&self, mut z: BranchPoint, held: usize) -> Result<BranchPoint, BranchError> {
+        let tol = (10.0 * self.tolerance).max(1e-14);
+        let (mut r, mut jac) = self.linearise(&z)?;
+        for _ in 0..CORRECTOR_ITERATIONS {
+            let residual = r.norm();
+            if residual < tol {
+                return Ok(z);
+            }
+            let mut a = Matrix6::zeros();
+            let mut k = 0;
+            for c in 0..7 {
+                if c != held {
+                    a.set_column(k, &jac.column(c));
+                    k += 1;
+                }
+            }
+            // a truncated SVD solve: a direction whose singular value is below
+            // 1e-7 of the largest is a branch point's null direction, in
+            // which the residual is the integrator's noise (on a symmetric
+            // branch through a pitchfork); stepping along it would amplify
+            // that noise
+            let svd = a.svd(true, true);
+            let cutoff = 1e-7 * svd.singular_values.max();
+            let Some(dx) = svd
+                .solve(&(-r), cutoff)
+                .ok()
+                .filter(|d| d.iter().all(|v| v.is_finite()))
+            else {
+                return Err(ContinuumError::Singular.into());
+            };
+            let mut step = BranchPoint::zeros();
+            let mut k = 0;
+            for c in 0..7 {
+                if c != held {
+                    step[c] = dx[k];
+                    k += 1;
+                }
+            }
+            // the step halved while the residual does not fall (a failed
+            // integration counts as not falling)
+            let mut t = 1.0;
+            let mut next = None;
+            for _ in 0..10 {
+                if let Ok((rn, jn)) = self.linearise(&(z + t * step))
+                    && rn.norm() < residual
+                {
+                    next = Some((rn, jn));
+                    break;
+                }
+                t *= 0.5;
+            }
+            let Some((rn, jn)) = next else {
+                // at the integrator's noise the residual no longer falls (near
+                // a branch point, whose null direction amplifies the noise,
+                // that floor lies well above the tolerance)
+                let scale = 1.0 + z.fixed_rows::<6>(0).norm();
+                if dx.norm() < 1e-9 * scale || residual < NOISE_FLOOR * self.tolerance {
+                    return Ok(z);
+                }
+                return Err(BranchError::Corrector {
+                    iterations: CORRECTOR_ITERATIONS,
+                    residual,
+                });
+            };
+            z += t * step;
+            (r, jac) = (rn, jn);
+            let scale = 1.0 + z.fixed_rows::<6>(0).norm();
+            if t == 1.0 && dx.norm() < 1e-11 * scale {
+                return Ok(z);
+            }
+        }
+        if r.norm() < NOISE_FLOOR * self.tolerance {
+            return Ok(z);
+        }
+        Err(BranchError::Corrector {
+            iterations: CORRECTOR_ITERATIONS,
+            residual: r.norm(),
+        })
+    }
+
+    /// Frames at the increasing arclengths `stops`, on the solution at z.
+    pub fn frames_at(&self, z: &BranchPoint, stops: &[f64]) -> Result<Vec<Frame>, BranchError> {
+        let p: Unknowns = z.fixed_rows::<6>(0).into();
+        Ok(self.problem(z[PARAMETER])?.frames_at(&p, stops)?)
+    }
+
+    /// The height of r along the s = 0 clamp's tangent (the walls' normal).
+    fn height(&self, z: &BranchPoint, r: &Vector3<f64>) -> f64 {
+        let c = self.clamps_at(z[PARAMETER]);
+        (r - c.start_point()).dot(&c.start_tangent())
+    }
+
+    /// The test function at z (its arclengths updated to the solution
+    /// there), and its value.
+    pub fn evaluate(
+        &self,
+        z: &BranchPoint,
+        test: &TestFunction,
+    ) -> Result<(TestFunction, f64), BranchError> {
+        match test {
+            TestFunction::Singular { left, right } => {
+                let p: Unknowns = z.fixed_rows::<6>(0).into();
+                let (_, j) = self.problem(z[PARAMETER])?.linearise(&p)?;
+                Ok((test.clone(), bordered_determinant(&j, left, right)?))
+            }
+            TestFunction::Wall { wall, s } => {
+                let (s, h) = self.extremum(z, *s)?;
+                Ok((TestFunction::Wall { wall: *wall, s }, h - wall))
+            }
+            TestFunction::Crossing { s } => {
+                let (s, d) = self.closest_strands(z, *s)?;
+                Ok((TestFunction::Crossing { s }, d))
+            }
+        }
+    }
+
+    /// The interior extremum of the height nearest arclength `s0`: Newton
+    /// on h'(s) = d3·e = 0 with h''(s) = d3'·e from the frame equations.
+    fn extremum(&self, z: &BranchPoint, s0: f64) -> Result<(f64, f64), BranchError> {
+        let axis = self.clamps_at(z[PARAMETER]).start_tangent();
+        let mut s = s0;
+        for _ in 0..30 {
+            let (f, d) = self.frame_and_rate(z, s)?;
+            let slope = f.d3.dot(&axis);
+            let curvature = d.dot(&axis);
+            if curvature == 0.0 || !curvature.is_finite() {
+                break;
+            }
+            let step = -slope / curvature;
+            s = (s + step).clamp(1e-6, 1.0 - 1e-6);
+            if step.abs() < 1e-13 {
+                let f = self.frames_at(z, &[s])?[0];
+                return Ok((s, self.height(z, &f.r)));
+            }
+        }
+        Err(BranchError::NoRoot(format!(
+            "no interior extremum of the height near s = {s0:.4}"
+        )))
+    }
+
+    /// The frame at s and d3'(s).
+    fn frame_and_rate(
+        &self,
+        z: &BranchPoint,
+        s: f64,
+    ) -> Result<(Frame, Vector3<f64>), BranchError> {
+        let f = self.frames_at(z, &[s])?[0];
+        Ok((f, f.curvature))
+    }
+
+    /// The closest points of two strands near arclengths `s0` (Newton on
+    /// the two orthogonality conditions) and their signed distance, positive
+    /// along t_a × t_b.
+    fn closest_strands(
+        &self,
+        z: &BranchPoint,
+        s0: [f64; 2],
+    ) -> Result<([f64; 2], f64), BranchError> {
+        let mut s = s0;
+        for _ in 0..30 {
+            let (fa, ra) = self.frame_and_rate(z, s[0])?;
+            let (fb, rb) = self.frame_and_rate(z, s[1])?;
+            let d = fa.r - fb.r;
+            let g = nalgebra::Vector2::new(d.dot(&fa.d3), -d.dot(&fb.d3));
+            let jac = nalgebra::Matrix2::new(
+                1.0 + d.dot(&ra),
+                -fb.d3.dot(&fa.d3),
+                -fa.d3.dot(&fb.d3),
+                1.0 - d.dot(&rb),
+            );
+            let Some(step) = jac.lu().solve(&(-g)) else {
+                break;
+            };
+            s = [
+                (s[0] + step[0]).clamp(0.0, 1.0),
+                (s[1] + step[1]).clamp(0.0, 1.0),
+            ];
+            if step.norm() < 1e-13 {
+                let f = self.frames_at(z, &[s[0], s[1]])?;
+                let normal = f[0].d3.cross(&f[1].d3);
+                if normal.norm() < 1e-8 {
+                    break;
+                }
+                let signed = (f[0].r - f[1].r).dot(&normal) / normal.norm();
+                return Ok((s, signed));
+            }
+        }
+        Err(BranchError::NoRoot(format!(
+            "no closest approach of the strands near s = {:.4}, {:.4}",
+            s0[0], s0[1]
+        )))
+    }
+
+    /// The root of `test` along the branch from `start` (on the branch or
+    /// near it), holding coordinate `held` and stepping it first by `step`:
+    /// secant steps in the held coordinate, each point corrected onto the
+    /// branch, until the step is below `resolution`.
+    pub fn locate(
+        &self,
+        start: BranchPoint,
+        held: usize,
+        step: f64,
+        resolution: f64,
+        test: TestFunction,
+    ) -> Result<Located, BranchError> {
+        let mut za = self.correct(start, held)?;
+        let (mut test, mut ga) = self.evaluate(&za, &test)?;
+        let mut zb = za;
+        zb[held] += step;
+        zb = self.correct(zb, held)?;
+        let (t, mut gb) = self.evaluate(&zb, &test)?;
+        test = t;
+        for k in 0..SECANT_ITERATIONS {
+            if gb == 0.0 {
+                return Ok(Located {
+                    point: zb,
+                    test,
+                    value: gb,
+                    steps: k,
+                    last_step: 0.0,
+                    previous: za,
+                });
+            }
+            if gb == ga || !gb.is_finite() {
+                break;
+            }
+            let dc = -gb * (zb[held] - za[held]) / (gb - ga);
+            if dc.abs() > 1e3 * step.abs().max((zb[held] - za[held]).abs()) {
+                break;
+            }
+            // the predictor: the secant of the branch through the last two points
+            let f = dc / (zb[held] - za[held]);
+            let zc = self.correct(zb + f * (zb - za), held)?;
+            let (t, gc) = self.evaluate(&zc, &test)?;
+            test = t;
+            za = zb;
+            ga = gb;
+            zb = zc;
+            gb = gc;
+            if dc.abs() < resolution {
+                return Ok(Located {
+                    point: zb,
+                    test,
+                    value: gb,
+                    steps: k + 1,
+                    last_step: dc,
+                    previous: za,
+                });
+            }
+        }
+        Err(BranchError::NoRoot(format!(
+            "secant steps in coordinate {held} did not converge (last values {ga:.3e}, {gb:.3e})"
+        )))
+    }
+}
+
+/// Index of the smallest singular value.
+fn smallest(values: &[f64]) -> Option<usize> {
+    values
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(k, _)| k)
+}
+
+/// The null vector of a full-rank 6×7 matrix (unit length).
+fn null_vector(a: &SMatrix<f64, 6, 7>) -> Option<BranchPoint> {
+    // the 7th right singular vector of the 7×7 matrix padded with a zero row
+    let mut m = SMatrix::<f64, 7, 7>::zeros();
+    m.fixed_rows_mut::<6>(0).copy_from(a);
+    let svd = m.svd(false, true);
+    let k = smallest(svd.singular_values.as_slice())?;
+    Some(svd.v_t?.row(k).transpose())
+}
+
+/// The left and right singular vectors of the smallest singular value of J.
+pub fn singular_borders(j: &Matrix6<f64>) -> Option<(Vector6<f64>, Vector6<f64>)> {
+    let svd = j.svd(true, true);
+    let k = smallest(svd.singular_values.as_slice())?;
+    Some((svd.u?.column(k).into(), svd.v_t?.row(k).transpose()))
+}
+
+/// g of [[J, b], [cᵀ, 0]] [v; g] = [0; 1]: zero exactly where J is singular,
+/// and smooth through it.
+fn bordered_determinant(
+    j: &Matrix6<f64>,
+    b: &Vector6<f64>,
+    c: &Vector6<f64>,
+) -> Result<f64, BranchError> {
+    let mut m = SMatrix::<f64, 7, 7>::zeros();
+    m.fixed_view_mut::<6, 6>(0, 0).copy_from(j);
+    m.fixed_view_mut::<6, 1>(0, 6).copy_from(b);
+    m.fixed_view_mut::<1, 6>(6, 0).copy_from(&c.transpose());
+    let mut rhs = SVector::<f64, 7>::zeros();
+    rhs[6] = 1.0;
+    m.lu()
+        .solve(&rhs)
+        .map(|x| x[6])
+        .ok_or(BranchError::Continuum(ContinuumError::Singular))
+}

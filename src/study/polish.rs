@@ -1,0 +1,229 @@
+//! The continuum polish of a branch's events: each fold, branch point,
+//! change of stability, wall and self-crossing that the discrete rod located
+//! is located again on the continuum branch (model::continuum_branch), from
+//! the discrete equilibrium there, to the integrator's tolerance. The two
+//! answers side by side give the discrete rod's error at its N, and the
+//! polished value carries its own error estimate (the change when the
+//! tolerance falls a hundredfold).
+
+use crate::analysis::equilibrium::{Measure, self_approach};
+use crate::analysis::event::{ContinuumEvent, Event, EventKind};
+use crate::model::continuum::Unknowns;
+use crate::model::continuum_branch::{
+    BranchPoint, ContinuumBranch, PARAMETER, TestFunction, singular_borders,
+};
+use crate::model::rod::{Parameter, RodModel, RodState};
+use rayon::prelude::*;
+
+/// Tolerance of the integrator for the polish (its error estimate comes from
+/// a second pass at a hundredth of it).
+pub const POLISH_TOLERANCE: f64 = 1e-10;
+
+/// What kind of root an event is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Class {
+    Singular,
+    Wall,
+    Crossing,
+}
+
+fn class(kind: EventKind) -> Option<Class> {
+    match kind {
+        EventKind::Fold | EventKind::Stability | EventKind::BranchPoint => Some(Class::Singular),
+        EventKind::Wall => Some(Class::Wall),
+        EventKind::Crossing | EventKind::KnotChange => Some(Class::Crossing),
+        _ => None,
+    }
+}
+
+/// Polish every event of `events` that has a continuum counterpart, from the
+/// equilibria `located` there (`located[k]` at `events[k]`), on the branch
+/// in `parameter` of `model`. Events at one place share one polish; one that
+/// cannot be polished says why in its detail.
+pub fn polish_events(
+    model: &RodModel,
+    parameter: Parameter,
+    measure: &Measure,
+    events: &mut [Event],
+    located: &[RodState],
+) {
+    // one polish per (branch, class, place)
+    let mut groups: Vec<(Class, usize, Vec<usize>)> = Vec::new();
+    for (k, e) in events.iter().enumerate() {
+        let Some(c) = class(e.kind) else { continue };
+        if k >= located.len() {
+            continue;
+        }
+        let value = parameter.value(&located[k].clamps);
+        match groups.iter_mut().find(|(gc, first, _)| {
+            *gc == c
+                && events[*first].branch == e.branch
+                && (parameter.value(&located[*first].clamps) - value).abs() < 1e-9
+        }) {
+            Some(g) => g.2.push(k),
+            None => groups.push((c, k, vec![k])),
+        }
+    }
+    let results: Vec<Result<ContinuumEvent, String>> = groups
+        .par_iter()
+        .map(|(c, first, members)| {
+            // a fold is a fold whichever event of its place is polished
+            let fold = members.iter().any(|&k| events[k].kind == EventKind::Fold);
+            polish_one(model, parameter, measure, &located[*first], *c, fold)
+        })
+        .collect();
+    for ((_, _, members), result) in groups.iter().zip(results) {
+        for &k in members {
+            match &result {
+                Ok(c) => events[k].continuum = Some(c.clone()),
+                Err(why) => events[k].detail.push_str(&format!("; not polished: {why}")),
+            }
+        }
+    }
+}
+
+/// The discrete rod's shooting unknowns at `state`: its clamp reactions
+/// (n(0), m(0)) for a rod, n(0), u1(0), m2(0), u3(0) for a strip.
+pub fn discrete_unknowns(model: &RodModel, state: &RodState) -> Unknowns {
+    use crate::model::energy::{RodEnergy, Terms};
+    use crate::model::rod::Law;
+    use crate::model::strip_shooting::StripUnknowns;
+    let energy = RodEnergy::with_ends(model.clone(), Terms::ALL, state.clamps.ends);
+    if matches!(model.law, Law::Strip { .. }) {
+        let p = StripUnknowns::from_der(&energy, state);
+        Unknowns::new(p.n0[0], p.n0[1], p.n0[2], p.u1, p.m2, p.u3)
+    } else {
+        let r = energy.clamp_reactions(state);
+        Unknowns::new(
+            r.force[0],
+            r.force[1],
+            r.force[2],
+            r.moment[0],
+            r.moment[1],
+            r.moment[2],
+        )
+    }
+}
+
+/// The test function of an event of class `c` at the discrete `state`.
+fn test_function(
+    branch: &ContinuumBranch,
+    z: &BranchPoint,
+    state: &RodState,
+    measure: &Measure,
+    c: Class,
+) -> Result<TestFunction, String> {
+    match c {
+        Class::Singular => {
+            let p: Unknowns = z.fixed_rows::<6>(0).into();
+            let (_, j) = branch
+                .problem(z[PARAMETER])
+                .and_then(|pr| Ok(pr.linearise(&p)?))
+                .map_err(|e| e.to_string())?;
+            let (left, right) = singular_borders(&j).ok_or("no singular vectors")?;
+            Ok(TestFunction::Singular { left, right })
+        }
+        Class::Wall => {
+            // the interior node nearest a wall
+            let (points, arc) = state.centreline();
+            let (origin, axis) = (state.clamps.start_point(), state.clamps.start_tangent());
+            let top = state.clamps.top_wall();
+            let n = state.segments();
+            let (mut best, mut wall, mut s) = (f64::INFINITY, 0.0, 0.5);
+            for i in 1..=n.min(points.len() - 2) {
+                let h = (points[i] - origin).dot(&axis);
+                for w in [0.0, top] {
+                    if (h - w).abs() < best {
+                        (best, wall, s) = ((h - w).abs(), w, arc[i]);
+                    }
+                }
+            }
+            Ok(TestFunction::Wall { wall, s })
+        }
+        Class::Crossing => {
+            let approach =
+                self_approach(state, measure).ok_or("no self-approach of the centreline")?;
+            // a strand passing through a ray, not through the centreline
+            if approach.distance > 2.0 / state.segments() as f64 {
+                return Err(format!(
+                    "the centreline's strands are {:.2e} apart (a crossing of a ray is not polished)",
+                    approach.distance
+                ));
+            }
+            Ok(TestFunction::Crossing { s: approach.s })
+        }
+    }
+}
+
+/// One event located on the continuum branch from the discrete `state`.
+fn polish_one(
+    model: &RodModel,
+    parameter: Parameter,
+    measure: &Measure,
+    state: &RodState,
+    c: Class,
+    fold: bool,
+) -> Result<ContinuumEvent, String> {
+    if measure.strip_width > 0.0 && c != Class::Singular {
+        return Err("walls and crossings of a ribbon are not polished".into());
+    }
+    let branch = ContinuumBranch::new(model, state.clamps, parameter, POLISH_TOLERANCE)
+        .map_err(|e| e.to_string())?;
+    let discrete = parameter.value(&state.clamps);
+    let mut z = BranchPoint::zeros();
+    z.fixed_rows_mut::<6>(0)
+        .copy_from(&discrete_unknowns(model, state));
+    z[PARAMETER] = discrete;
+    // hold the parameter, except at a fold: there the unknown the branch
+    // moves along fastest (relative to its size)
+    let held = if fold {
+        let t = branch.tangent(&z).map_err(|e| e.to_string())?;
+        (0..6)
+            .max_by(|&a, &b| {
+                let w = |k: usize| t[k].abs() / (1.0 + z[k].abs());
+                w(a).total_cmp(&w(b))
+            })
+            .unwrap_or(0)
+    } else {
+        PARAMETER
+    };
+    let test = test_function(&branch, &z, state, measure, c)?;
+    let scale = 1.0 + z[held].abs();
+    // at a fold the parameter is stationary in the held unknown: an error δ
+    // there moves it by O(δ²), so δ = 1e-7 suffices (and the test
+    // function's noise forbids much less)
+    let resolution = if held == PARAMETER { 1e-10 } else { 1e-7 } * scale;
+    let coarse = branch
+        .locate(z, held, 1e-4 * scale, resolution, test)
+        .map_err(|e| e.to_string())?;
+    // the same root at a hundredth of the tolerance, from the first
+    let fine_branch = branch.with_tolerance(POLISH_TOLERANCE * 1e-2);
+    let step = (10.0 * coarse.last_step.abs()).max(1e-8 * scale);
+    let fine = fine_branch
+        .locate(coarse.point, held, step, resolution, coarse.test.clone())
+        .map_err(|e| e.to_string())?;
+    let value = fine.point[PARAMETER];
+    let error = (coarse.point[PARAMETER] - value).abs()
+        + (fine.point[PARAMETER] - fine.previous[PARAMETER]).abs();
+    let p: Unknowns = fine.point.fixed_rows::<6>(0).into();
+    let twist = fine_branch
+        .problem(value)
+        .and_then(|pr| Ok(pr.solve(&p, 0)?))
+        .map_err(|e| e.to_string())?
+        .twist;
+    let arclengths = match &fine.test {
+        TestFunction::Wall { s, .. } => vec![*s],
+        TestFunction::Crossing { s } => s.to_vec(),
+        TestFunction::Singular { .. } => vec![],
+    };
+    Ok(ContinuumEvent {
+        parameter,
+        value,
+        error,
+        discrete_minus_continuum: discrete - value,
+        twist,
+        unknowns: [p[0], p[1], p[2], p[3], p[4], p[5]],
+        arclengths,
+        steps: coarse.steps + fine.steps,
+    })
+}

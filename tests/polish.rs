@@ -1,0 +1,150 @@
+//! The continuum polish of a branch's events (issue 20): the Figure 3 branch
+//! from X to the fold found by a coarse discrete rod, every event located
+//! again on the continuum branch, checked against AUTO-07p, against an
+//! independent fixed-step integrator, against itself from another start, and
+//! the discrete rod's error against it converging in N.
+
+use knotrod::analysis::event::{Event, EventKind};
+use knotrod::model::continuum::Unknowns;
+use knotrod::model::continuum_branch::{BranchPoint, ContinuumBranch, PARAMETER};
+use knotrod::model::natural::NaturalStrains;
+use knotrod::model::ode::central_jacobian;
+use knotrod::model::shooting::ShootingSolution;
+use knotrod::scene::Scene;
+use knotrod::study::run::run_scene;
+use nalgebra::Vector3;
+use std::path::Path;
+
+fn polished_events(n: usize) -> (Scene, Vec<Event>) {
+    let scene = Scene::load(Path::new("scenes/fig3_polished.toml")).unwrap();
+    let events = run_scene(&scene, Some(n), &mut |_| Ok(())).unwrap();
+    (scene, events)
+}
+
+/// The polished event labelled `label` (of `kind`).
+fn find<'a>(events: &'a [Event], label: &str, kind: EventKind) -> &'a Event {
+    events
+        .iter()
+        .find(|e| e.label == label && e.kind == kind)
+        .unwrap_or_else(|| panic!("no {label} ({kind}) in {events:#?}"))
+}
+
+const EVENTS: [(&str, EventKind); 5] = [
+    ("W2", EventKind::Wall),
+    ("X", EventKind::Crossing),
+    ("W1", EventKind::Wall),
+    ("S", EventKind::BranchPoint),
+    ("F1", EventKind::Fold),
+];
+
+/// AUTO-07p 0.9.2 (NCOL = 4, NTST = 400; benches/peers/auto07p) on the same
+/// branch: its fold LP, and the walls and crossing from its collocation
+/// polynomials (its branch point, located with the EPSS = 1e-3 it needs to
+/// find S at all, lies 1e-6 off and is checked otherwise below).
+const AUTO_07P: [(&str, f64); 4] = [
+    ("W2", 0.8182439365),
+    ("X", 0.9639507200),
+    ("W1", 0.7738218532),
+    ("F1", 0.7390451490),
+];
+
+#[test]
+fn every_event_is_polished_and_agrees_with_auto_07p_and_with_itself_from_another_n() {
+    let (_, coarse) = polished_events(60);
+    let (_, finer) = polished_events(120);
+    for (label, kind) in EVENTS {
+        let a = find(&coarse, label, kind).continuum.as_ref().unwrap();
+        let b = find(&finer, label, kind).continuum.as_ref().unwrap();
+        // the error bars are small and cover the difference between two
+        // polishes from different discrete starts
+        assert!(a.error < 1e-8 && b.error < 1e-8, "{label}: {a:?} {b:?}");
+        assert!(
+            (a.value - b.value).abs() <= a.error + b.error + 1e-11,
+            "{label}: {} ± {:.1e} vs {} ± {:.1e}",
+            a.value,
+            a.error,
+            b.value,
+            b.error
+        );
+        // the discrete rod converges to it, at second order for the
+        // events the discrete rod locates on its own Hessian (S and the fold)
+        let order = (a.discrete_minus_continuum / b.discrete_minus_continuum)
+            .abs()
+            .log2();
+        assert!(
+            b.discrete_minus_continuum.abs() < a.discrete_minus_continuum.abs() && order > 1.0,
+            "{label}: discrete errors {:.3e} (N = 60), {:.3e} (N = 120)",
+            a.discrete_minus_continuum,
+            b.discrete_minus_continuum
+        );
+        if matches!(kind, EventKind::BranchPoint | EventKind::Fold) {
+            assert!((1.8..2.3).contains(&order), "{label}: order {order}");
+        }
+        if let Some((_, auto)) = AUTO_07P.iter().find(|(l, _)| *l == label) {
+            // AUTO's values carry 1e-10 digits and a few 1e-9 of its own
+            // interpolation between stored solutions
+            assert!(
+                (a.value - auto).abs() < 2e-8,
+                "{label}: {} vs AUTO-07p {auto}",
+                a.value
+            );
+        }
+    }
+}
+
+#[test]
+fn the_polished_branch_point_is_where_a_fixed_step_shooting_jacobian_is_singular() {
+    // independent of the adaptive integrator and its variational equations:
+    // classical RK4 at 20 000 steps, Jacobian by central differences
+    let (scene, events) = polished_events(60);
+    let s = find(&events, "S", EventKind::BranchPoint)
+        .continuum
+        .clone()
+        .unwrap();
+    let model = scene.rod_model(Some(60));
+    let clamps = knotrod::model::rod::Clamps::new(0.115, 0.05, s.value);
+    let branch =
+        ContinuumBranch::new(&model, clamps, knotrod::model::rod::Parameter::Phi, 1e-12).unwrap();
+    let det_at = |value: f64| {
+        let mut z = BranchPoint::zeros();
+        z.fixed_rows_mut::<6>(0)
+            .copy_from(&Unknowns::from(s.unknowns));
+        z[PARAMETER] = value;
+        let z = branch.correct(z, PARAMETER).unwrap();
+        let c = branch.clamps_at(value);
+        let p: Unknowns = z.fixed_rows::<6>(0).into();
+        central_jacobian(&p, |q| {
+            ShootingSolution::integrate_from(
+                &c,
+                q.fixed_rows::<3>(0).into(),
+                q.fixed_rows::<3>(3).into(),
+                [3.0, 3.0],
+                (Vector3::zeros(), NaturalStrains::default()),
+                20_000,
+            )
+            .boundary_residual(&c)
+        })
+        .determinant()
+    };
+    let (below, above) = (det_at(s.value - 2e-8), det_at(s.value + 2e-8));
+    assert!(
+        below * above < 0.0,
+        "det {below:.3e} at S − 2e-8, {above:.3e} at S + 2e-8"
+    );
+    // AUTO-07p's branch point is not there: the determinant has the sign
+    // it has 1e-6 above S
+    let auto = det_at(0.7509637535);
+    assert!(auto * above > 0.0 && auto.abs() > 10.0 * above.abs());
+}
+
+#[test]
+fn the_polish_is_reported_in_the_summary_json() {
+    let (_, events) = polished_events(60);
+    let json = serde_json::to_string(&events).unwrap();
+    let back: Vec<Event> = serde_json::from_str(&json).unwrap();
+    assert_eq!(back, events);
+    assert!(json.contains("\"continuum\""));
+    // a branch stopped at its first fold: nothing beyond it
+    let folds = events.iter().filter(|e| e.kind == EventKind::Fold).count();
+    assert_eq!(folds, 1, "{events:#?}");
+}
