@@ -34,6 +34,9 @@ pub struct Workload {
     pub factorizations: usize,
     /// Peak resident memory of the process so far (Linux VmHWM), bytes.
     pub peak_bytes: u64,
+    /// Largest error of its answers against the converged continuum ones
+    /// (events: in φ/2π), where it has answers to compare.
+    pub accuracy: Option<f64>,
 }
 
 /// The bench report.
@@ -77,6 +80,7 @@ fn timed(name: &str, segments: usize, f: impl FnOnce() -> Result<()>) -> Result<
         newton_iterations: NEWTON_ITERATIONS.load(Ordering::Relaxed) - it0,
         factorizations: FACTORIZATIONS.load(Ordering::Relaxed) - f0,
         peak_bytes: peak_bytes(),
+        accuracy: None,
     })
 }
 
@@ -98,6 +102,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
     let fig3 = Scene::load(&scenes.join("fig3_kirchhoff.toml"))?;
     let fig7 = Scene::load(&scenes.join("fig7_island_kirchhoff.toml"))?;
     let mut workloads = branch_workloads(&d, &fig3)?;
+    workloads.extend(event_workloads(scenes)?);
     workloads.extend(island_workloads(&fig7)?);
     workloads.push(dense_knot_workload()?);
     workloads.push(verify_workload(scenes)?);
@@ -175,6 +180,74 @@ fn branch_workloads(d: &Scene, fig3: &Scene) -> Result<Vec<Workload>> {
             .map(|_| ())
             .map_err(Into::into)
     })?);
+    Ok(workloads)
+}
+
+/// Names of the workloads that compute the Figure 3 events from X to the fold.
+const EVENT_WORKLOAD: &str = "figure_3_x_to_fold";
+
+/// The labelled events whose accuracy the event workloads report.
+const FIGURE_3_EVENTS: [(&str, crate::analysis::event::EventKind); 5] = {
+    use crate::analysis::event::EventKind::{BranchPoint, Crossing, Fold, Wall};
+    [
+        ("W2", Wall),
+        ("X", Crossing),
+        ("W1", Wall),
+        ("S", BranchPoint),
+        ("F1", Fold),
+    ]
+};
+
+/// The value of each Figure 3 event in `events`: the continuum's where it
+/// was polished, else the discrete rod's.
+fn figure_3_values(events: &[crate::analysis::event::Event]) -> Result<Vec<f64>> {
+    FIGURE_3_EVENTS
+        .iter()
+        .map(|(label, kind)| {
+            let e = events
+                .iter()
+                .find(|e| e.branch == 0 && e.label == *label && e.kind == *kind)
+                .with_context(|| format!("no {label} on the Figure 3 branch"))?;
+            Ok(e.continuum.as_ref().map_or(e.phi_over_2pi, |c| c.value))
+        })
+        .collect()
+}
+
+/// The Figure 3 branch from X to the fold (scenes/fig3_polished.toml): by
+/// the discrete rod alone at N = 200 and 400, and at N = 60 with every
+/// event polished on the continuum branch; each with its largest event
+/// error against the polish from another start, the discrete rod at
+/// N = 120 (not timed).
+fn event_workloads(scenes: &Path) -> Result<Vec<Workload>> {
+    let polished = Scene::load(&scenes.join("fig3_polished.toml"))?;
+    let run = |scene: &Scene, n: usize| -> Result<Vec<crate::analysis::event::Event>> {
+        Ok(crate::study::run::run_scene(scene, Some(n), &mut |_| Ok(()))?)
+    };
+    let reference = figure_3_values(&run(&polished, 120)?)?;
+    let mut discrete = polished.clone();
+    if let Some(c) = discrete.continuation.as_mut() {
+        c.polish = false;
+    }
+    let mut workloads = Vec::new();
+    for (scene, n, name) in [
+        (&discrete, 200, "discrete"),
+        (&discrete, 400, "discrete"),
+        (&polished, 60, "polished"),
+    ] {
+        let mut values = Vec::new();
+        let mut w = timed(&format!("{EVENT_WORKLOAD}_{name}"), n, || {
+            values = figure_3_values(&run(scene, n)?)?;
+            Ok(())
+        })?;
+        w.accuracy = Some(
+            values
+                .iter()
+                .zip(&reference)
+                .map(|(v, r)| (v - r).abs())
+                .fold(0.0, f64::max),
+        );
+        workloads.push(w);
+    }
     Ok(workloads)
 }
 
@@ -362,20 +435,46 @@ fn dense_knot_workload() -> Result<Workload> {
 pub fn print(r: &Report, out: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(
         out,
-        "| workload | N | seconds | Newton iterations | factorisations | peak memory (MB) |"
+        "| workload | N | seconds | Newton iterations | factorisations | peak memory (MB) | largest error |"
     )?;
-    writeln!(out, "|---|---|---|---|---|---|")?;
+    writeln!(out, "|---|---|---|---|---|---|---|")?;
     for w in &r.workloads {
         writeln!(
             out,
-            "| {} | {} | {:.3} | {} | {} | {:.1} |",
+            "| {} | {} | {:.3} | {} | {} | {:.1} | {} |",
             w.name,
             w.segments,
             w.seconds,
             w.newton_iterations,
             w.factorizations,
-            w.peak_bytes as f64 / 1e6
+            w.peak_bytes as f64 / 1e6,
+            w.accuracy.map_or("".into(), |a| format!("{a:.1e}"))
         )?;
+    }
+    writeln!(
+        out,
+        "\nTime to the Figure 3 events (W2, X, W1, S, F1, from X to the fold) within a given error of the converged continuum values (the fastest workload above that reaches it):\n"
+    )?;
+    writeln!(out, "| within | workload | N | seconds | largest error |")?;
+    writeln!(out, "|---|---|---|---|---|")?;
+    for within in [1e-4, 1e-6, 1e-8] {
+        let best = r
+            .workloads
+            .iter()
+            .filter(|w| w.name.starts_with(EVENT_WORKLOAD))
+            .filter(|w| w.accuracy.is_some_and(|a| a <= within))
+            .min_by(|a, b| a.seconds.total_cmp(&b.seconds));
+        match best {
+            Some(w) => writeln!(
+                out,
+                "| {within:.0e} | {} | {} | {:.3} | {:.1e} |",
+                w.name,
+                w.segments,
+                w.seconds,
+                w.accuracy.unwrap_or(f64::NAN)
+            )?,
+            None => writeln!(out, "| {within:.0e} | none measured | | | |")?,
+        }
     }
     writeln!(
         out,
