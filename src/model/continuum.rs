@@ -590,8 +590,8 @@ impl Continuum {
         Ok(self.solve(p, 0)?.end_residual)
     }
 
-    /// Newton shooting from `p` on the six s = 1 conditions (Jacobian by
-    /// central differences, steps halved while the residual grows).
+    /// Newton shooting from `p` on the six s = 1 conditions (Jacobian of
+    /// [`Self::linearise`], steps halved while the residual grows).
     pub fn polish(&self, p: &Unknowns) -> Result<Polished, ContinuumError> {
         self.residual(p)?;
         // a failed integration inside the Jacobian counts as an infinite residual
@@ -599,7 +599,13 @@ impl Continuum {
             self.residual(q)
                 .unwrap_or_else(|_| Vector6::repeat(f64::INFINITY))
         };
-        match newton_shooting(*p, res, NEWTON_TOL, NEWTON_ITERATIONS, 12) {
+        // the exact Jacobian (variational equations for a rod): quadratic
+        // convergence down to the integrator's tolerance
+        let jacobian = |q: &Vector6<f64>| {
+            self.linearise(q)
+                .map_or_else(|_| Matrix6::repeat(f64::NAN), |(_, j)| j)
+        };
+        match newton_shooting(*p, res, jacobian, NEWTON_TOL, NEWTON_ITERATIONS, 12) {
             Ok((unknowns, residual, iterations)) => Ok(Polished {
                 unknowns,
                 residual,

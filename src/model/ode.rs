@@ -81,13 +81,14 @@ pub enum NewtonShootingFailure {
     },
 }
 
-/// Newton's method on the six s = 1 conditions `res` from `p` (Jacobian by
-/// central differences; the step halved up to `halvings` times while the
-/// residual does not fall): the unknowns, their residual's norm and the
-/// iterations made, once the norm is below `tol`.
+/// Newton's method on the six s = 1 conditions `res` from `p` (Jacobian
+/// `jacobian`, e.g. [`central_jacobian`] of `res`; the step halved up to
+/// `halvings` times while the residual does not fall): the unknowns, their
+/// residual's norm and the iterations made, once the norm is below `tol`.
 pub fn newton_shooting(
     mut p: Vector6<f64>,
     res: impl Fn(&Vector6<f64>) -> Vector6<f64>,
+    jacobian: impl Fn(&Vector6<f64>) -> Matrix6<f64>,
     tol: f64,
     iterations: usize,
     halvings: usize,
@@ -97,7 +98,7 @@ pub fn newton_shooting(
         if r.norm() < tol {
             return Ok((p, r.norm(), iteration));
         }
-        let dp = central_jacobian(&p, &res)
+        let dp = jacobian(&p)
             .lu()
             .solve(&(-r))
             .filter(|d| d.iter().all(|v| v.is_finite()))

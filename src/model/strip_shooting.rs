@@ -19,7 +19,7 @@
 use crate::linalg::jet;
 use crate::model::energy::{RodEnergy, strip_energy, vertex_strains};
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::{NewtonShootingFailure, hermite, newton_shooting, rk4};
+use crate::model::ode::{NewtonShootingFailure, central_jacobian, hermite, newton_shooting, rk4};
 use crate::model::rod::{Clamps, RodState};
 use crate::model::shooting::end_mismatch;
 use nalgebra::{Matrix2, SVector, Vector2, Vector3, Vector6};
@@ -289,7 +289,14 @@ impl StripProblem {
     /// residual below 1e-11.
     pub fn refine(&self, start: StripUnknowns) -> Result<StripUnknowns, StripShootingError> {
         let res = |p: &Vector6<f64>| self.residual(&StripUnknowns::from_vector(p));
-        match newton_shooting(start.to_vector(), res, 1e-11, 30, 8) {
+        match newton_shooting(
+            start.to_vector(),
+            res,
+            |q| central_jacobian(q, res),
+            1e-11,
+            30,
+            8,
+        ) {
             Ok((p, _, _)) => Ok(StripUnknowns::from_vector(&p)),
             Err(NewtonShootingFailure::Singular) => Err(StripShootingError::Singular),
             Err(NewtonShootingFailure::NotConverged {

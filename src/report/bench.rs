@@ -221,7 +221,9 @@ fn figure_3_values(events: &[crate::analysis::event::Event]) -> Result<Vec<f64>>
 fn event_workloads(scenes: &Path) -> Result<Vec<Workload>> {
     let polished = Scene::load(&scenes.join("fig3_polished.toml"))?;
     let run = |scene: &Scene, n: usize| -> Result<Vec<crate::analysis::event::Event>> {
-        Ok(crate::study::run::run_scene(scene, Some(n), &mut |_| Ok(()))?)
+        Ok(crate::study::run::run_scene(scene, Some(n), &mut |_| {
+            Ok(())
+        })?)
     };
     let reference = figure_3_values(&run(&polished, 120)?)?;
     let mut discrete = polished.clone();
