@@ -2,19 +2,24 @@
 //! its exact gradient and Hessian.
 //!
 //! Each term is a small stencil function generic over the scalar; derivatives are
-//! exact, by forward-mode automatic differentiation with (hyper-)dual numbers of
-//! the stencil (11 variables at a vertex, 6 at an edge), then scattered into a
-//! sparse Hessian of fixed pattern. Reference directors of the two edges of a
-//! vertex follow the perturbation by time-parallel transport, and the reference
-//! twist is continued from its stored value, exactly as the state update does,
-//! so these derivatives are those of the energy along the solver's own steps.
+//! exact and scattered into a sparse Hessian of fixed pattern. At a vertex (8
+//! variables: two edges, two angles) the strains' gradients and Hessians are
+//! in closed form ([`crate::model::strain_hessian`]) and the law's derivatives
+//! in the three strains come from a small jet, so every law shares the chain
+//! rule; jets of the whole stencil remain its fallback and the tests' oracle.
+//! An edge's stretching (3 variables) is differentiated by jets. Reference
+//! directors of the two edges of a vertex follow the perturbation by
+//! time-parallel transport, and the reference twist is continued from its
+//! stored value, exactly as the state update does, so these derivatives are
+//! those of the energy along the solver's own steps.
 
-use crate::linalg::jet::{self, Jet3, Jet4, Jet8};
+use crate::linalg::jet::{self, Grad, Jet3, Jet4, Jet8};
 use crate::linalg::sparse::{NO_SLOT, SymmetricPattern};
 use crate::model::frames::{self, Scalar, V3, lift};
 use crate::model::rod::{
     ClampVelocity, Clamps, DofMap, EndKind, Ends, Law, RodModel, RodState, tangent,
 };
+use crate::model::strain_hessian::{self, QuaternionDerivatives, VertexChart};
 use nalgebra::Vector3;
 
 /// Which energy terms to include.
@@ -357,8 +362,97 @@ pub fn vertex_energy<T: Scalar>(
     )
 }
 
-/// Energy, gradient and Hessian of [`vertex_energy`] (through [`strain_jets`]).
+/// Energy and gradient of [`vertex_energy`]: ∂E/∂s through the closed-form
+/// strain gradients, or by jets of the stencil where those do not apply.
+fn vertex_energy_gradient(
+    q: [f64; 8],
+    c: &VertexFrames,
+    model: (&RodModel, [f64; 3]),
+    terms: Terms,
+    multiplier: Option<VertexMultiplier>,
+) -> (f64, [f64; 8]) {
+    let Some((s, chart)) = vertex_chart(&q, c) else {
+        return jet::gradient(q, |v| vertex_energy(v, c, model, terms, multiplier));
+    };
+    let strains = Strains {
+        k1: Grad::<3>::variable(s.k1, 0),
+        k2: Grad::<3>::variable(s.k2, 1),
+        m: Grad::<3>::variable(s.m, 2),
+    };
+    let e = energy_of_strains(strains, model, terms, multiplier);
+    let mut g_q = [0.0; 4];
+    for (a, g) in chart.strain_gradients().iter().enumerate() {
+        for r in 0..4 {
+            g_q[r] += e.g[a] * g[r];
+        }
+    }
+    (e.v, chart.gradient(&g_q))
+}
+
+/// How far a stored reference director may be from unit length and from
+/// normal to its stored tangent, and an edge from its stored tangent, for the
+/// closed-form derivatives. The rod's own frame update keeps all three at
+/// round-off; a state edited by hand (nodes moved, frames not transported)
+/// is differentiated by jets instead.
+const CHART_TOLERANCE: f64 = 1e-10;
+
+/// The strains at vertex variables `q` and the chart of their closed-form
+/// derivatives ([`strain_hessian`]), or `None` where its assumption (unit
+/// reference directors normal to the edges, edges at the stored tangents)
+/// does not hold.
+fn vertex_chart(q: &[f64; 8], c: &VertexFrames) -> Option<(Strains<f64>, VertexChart)> {
+    let f = edge_frames(q, c);
+    let stored = [(&c.a_prev, &c.t_prev), (&c.a, &c.t)];
+    for (k, (a, t)) in stored.into_iter().enumerate() {
+        let drift = (Vector3::from(f[k].t) - t).norm_squared();
+        if a.dot(t).abs() > CHART_TOLERANCE
+            || (a.norm_squared() - 1.0).abs() > CHART_TOLERANCE
+            || drift > CHART_TOLERANCE * CHART_TOLERANCE
+        {
+            return None;
+        }
+    }
+    let frame = |k: usize| strain_hessian::EdgeFrame {
+        d1: Vector3::from(f[k].d1),
+        d2: Vector3::from(f[k].d2),
+        t: Vector3::from(f[k].t),
+        length: frames::norm([q[3 * k], q[3 * k + 1], q[3 * k + 2]]),
+    };
+    Some((strains(&f, c), VertexChart::new([frame(0), frame(1)])))
+}
+
+/// The strains as the three independent variables of a [`Jet3`], so that
+/// [`energy_of_strains`] gives ∂E/∂s and ∂²E/∂s² for every law.
+fn strain_variables(s: Strains<f64>) -> Strains<Jet3> {
+    Strains {
+        k1: Jet3::variable(s.k1, 0),
+        k2: Jet3::variable(s.k2, 1),
+        m: Jet3::variable(s.m, 2),
+    }
+}
+
+/// Energy, gradient and Hessian of [`vertex_energy`]: the chain rule
+/// H = Jᵀ ∂²E/∂s² J + Σ ∂E/∂s_a ∇²s_a through the closed-form strain
+/// derivatives, or through [`strain_jets`] where those do not apply.
 fn vertex_energy_hessian(
+    q: [f64; 8],
+    c: &VertexFrames,
+    model: (&RodModel, [f64; 3]),
+    terms: Terms,
+    multiplier: Option<VertexMultiplier>,
+) -> (f64, [f64; 8], [[f64; 8]; 8]) {
+    let Some((s, chart)) = vertex_chart(&q, c) else {
+        return vertex_energy_hessian_by_jets(q, c, model, terms, multiplier);
+    };
+    let e = energy_of_strains(strain_variables(s), model, terms, multiplier);
+    let d = QuaternionDerivatives::compose(&chart.strains(), e.g, e.dense_hessian());
+    let (g, h) = chart.hessian(&d);
+    (e.v, g, h)
+}
+
+/// [`vertex_energy_hessian`] by jets of the whole stencil: the fallback, and
+/// the tests' oracle.
+fn vertex_energy_hessian_by_jets(
     q: [f64; 8],
     c: &VertexFrames,
     model: (&RodModel, [f64; 3]),
@@ -520,7 +614,11 @@ impl RodEnergy {
         rows.clear();
         rows.extend((1..=self.model.segments).map(|i| {
             let c = VertexFrames::at(state, i);
-            let (v, g8) = jet::gradient(vertex_variables(state, i), |v| normal_curvature(v, &c));
+            let q = vertex_variables(state, i);
+            let (v, g8) = match vertex_chart(&q, &c) {
+                Some((s, chart)) => (s.k2, chart.gradient(&chart.strain_gradients()[1])),
+                None => jet::gradient(q, |v| normal_curvature(v, &c)),
+            };
             (v, vertex_gradient_to_nodes(&g8))
         }));
     }
@@ -603,17 +701,80 @@ impl RodEnergy {
         i: usize,
         model: &RodModel,
     ) -> (f64, [f64; 11], [f64; 121]) {
-        let c = VertexFrames::at(state, i);
-        let w = self.multiplier(state, i);
-        let (e, g8, h8) = vertex_energy_hessian(
-            vertex_variables(state, i),
-            &c,
-            (model, natural_at(model, i)),
-            self.terms,
-            w,
-        );
+        let (e, g8, h8) = self.vertex_hessian8(state, i, model);
         let (g, h) = vertex_to_nodes(&g8, h8.as_flattened());
         (e, g, h)
+    }
+
+    /// Energy, gradient and Hessian of vertex i in its 8 variables
+    /// (e_{i-1}, e_i, θ_{i-1}, θ_i).
+    fn vertex_hessian8(
+        &self,
+        state: &RodState,
+        i: usize,
+        model: &RodModel,
+    ) -> (f64, [f64; 8], [[f64; 8]; 8]) {
+        vertex_energy_hessian(
+            vertex_variables(state, i),
+            &VertexFrames::at(state, i),
+            (model, natural_at(model, i)),
+            self.terms,
+            self.multiplier(state, i),
+        )
+    }
+
+    /// Add vertex i's gradient and Hessian in its 8 variables to the free
+    /// gradient and the Hessian values; returns the squared norm of its node
+    /// gradient. The upper triangle of the node Hessian is formed entry by
+    /// entry as it is scattered (no 11×11 block in between); a stencil with
+    /// a pinned end's ghost node takes the general path through
+    /// [`Self::fold_pinned`].
+    fn scatter_vertex(
+        &self,
+        i: usize,
+        g8: &[f64; 8],
+        h8: &[[f64; 8]; 8],
+        grad: &mut [f64],
+        values: &mut [f64],
+    ) -> f64 {
+        let slots = &self.pattern.slots[i - 1];
+        if self.map.pinned_block(&[i - 1, i, i + 1]).is_some() {
+            let (mut gl, mut hl) = vertex_to_nodes(g8, h8.as_flattened());
+            self.fold_pinned(&[i - 1, i, i + 1], &mut gl, Some(&mut hl));
+            scatter_hessian(slots, 11, &hl, values);
+            return scatter(&self.map.vertex_stencil(i), &gl, grad);
+        }
+        // node variable a = Σ c v over its (8-variable v, coefficient c) pairs:
+        // e_{i-1} = x_i − x_{i−1}, e_i = x_{i+1} − x_i
+        const NODE_TERMS: [[(usize, f64); 2]; 11] = [
+            [(0, -1.0), (0, 0.0)],
+            [(1, -1.0), (1, 0.0)],
+            [(2, -1.0), (2, 0.0)],
+            [(0, 1.0), (3, -1.0)],
+            [(1, 1.0), (4, -1.0)],
+            [(2, 1.0), (5, -1.0)],
+            [(3, 1.0), (3, 0.0)],
+            [(4, 1.0), (4, 0.0)],
+            [(5, 1.0), (5, 0.0)],
+            [(6, 1.0), (6, 0.0)],
+            [(7, 1.0), (7, 0.0)],
+        ];
+        for a in 0..11 {
+            let [(u0, c0), (u1, c1)] = NODE_TERMS[a];
+            for b in a..11 {
+                let s = slots[a * 11 + b];
+                if s != NO_SLOT {
+                    let [(v0, d0), (v1, d1)] = NODE_TERMS[b];
+                    values[s] += c0 * (d0 * h8[u0][v0] + d1 * h8[u0][v1])
+                        + c1 * (d0 * h8[u1][v0] + d1 * h8[u1][v1]);
+                }
+            }
+        }
+        scatter(
+            &self.map.vertex_stencil(i),
+            &vertex_gradient_to_nodes(g8),
+            grad,
+        )
     }
 
     /// Energy, node-variable gradient and Hessian (row-major 6×6) of the
@@ -642,13 +803,16 @@ impl RodEnergy {
         (e, g, h)
     }
 
+    /// Energy and node-variable gradient of the bending and twisting at
+    /// vertex i.
     fn vertex_gradient(&self, state: &RodState, i: usize, model: &RodModel) -> (f64, [f64; 11]) {
-        let c = VertexFrames::at(state, i);
-        let w = self.multiplier(state, i);
-        let natural = natural_at(model, i);
-        let (e, g8) = jet::gradient(vertex_variables(state, i), |v| {
-            vertex_energy(v, &c, (model, natural), self.terms, w)
-        });
+        let (e, g8) = vertex_energy_gradient(
+            vertex_variables(state, i),
+            &VertexFrames::at(state, i),
+            (model, natural_at(model, i)),
+            self.terms,
+            self.multiplier(state, i),
+        );
         (e, vertex_gradient_to_nodes(&g8))
     }
 
@@ -792,27 +956,20 @@ impl RodEnergy {
     }
 
     /// Gradient and Hessian (upper values on `self.pattern`) on the free dofs.
-    /// The stencils are evaluated in parallel, then scattered in order (so the
-    /// result does not depend on the number of threads).
+    /// One pass over the stencils in order, without allocation: with the
+    /// closed-form stencil derivatives a vertex costs about as much as
+    /// handing it to another thread would.
     pub fn hessian(&self, state: &RodState, grad: &mut [f64], values: &mut [f64]) -> GradientInfo {
-        use rayon::prelude::*;
         let n = self.model.segments;
         let model = self.model_at(state);
         grad.iter_mut().for_each(|v| *v = 0.0);
         values.iter_mut().for_each(|x| *x = 0.0);
         let (mut energy, mut scale2) = (0.0, 0.0);
         if self.terms.bending || self.terms.twisting {
-            let local: Vec<(f64, [f64; 11], [f64; 121])> = (1..n + 1)
-                .into_par_iter()
-                .with_min_len(16)
-                .map(|i| self.vertex_local_with(state, i, &model))
-                .collect();
-            for (k, (e, mut gl, mut hl)) in local.into_iter().enumerate() {
-                let i = k + 1;
-                self.fold_pinned(&[i - 1, i, i + 1], &mut gl, Some(&mut hl));
+            for i in 1..=n {
+                let (e, g8, h8) = self.vertex_hessian8(state, i, &model);
                 energy += e;
-                scale2 += scatter(&self.map.vertex_stencil(i), &gl, grad);
-                scatter_hessian(&self.pattern.slots[i - 1], 11, &hl, values);
+                scale2 += self.scatter_vertex(i, &g8, &h8, grad, values);
             }
         }
         if self.terms.stretching {
@@ -1090,4 +1247,227 @@ impl RodEnergy {
 /// û of `model` at vertex i (its arc length (i − ½)h).
 fn natural_at(model: &RodModel, i: usize) -> [f64; 3] {
     model.natural_strains.at_vertex(i, model.segments)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Uniform numbers in [−1, 1) from a fixed seed.
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        }
+
+        fn vector(&mut self) -> Vector3<f64> {
+            Vector3::new(self.next(), self.next(), self.next())
+        }
+    }
+
+    /// A random stencil at its own frames: edges of random length and a bend
+    /// of up to about 120°, unit reference directors normal to them, any
+    /// angles and any reference twist (continued a few turns).
+    fn random_stencil(rng: &mut Rng) -> ([f64; 8], VertexFrames) {
+        let t0 = rng.vector().normalize();
+        let t1 = loop {
+            let t1 = (t0 + 1.2 * rng.vector()).normalize();
+            if t0.dot(&t1) > -0.5 {
+                break t1;
+            }
+        };
+        let e0 = t0 * (0.05 + 0.3 * (rng.next() + 1.0));
+        let e1 = t1 * (0.05 + 0.3 * (rng.next() + 1.0));
+        let normal = |t: &Vector3<f64>, v: Vector3<f64>| (v - v.dot(t) * t).normalize();
+        let c = VertexFrames {
+            a_prev: normal(&t0, rng.vector()),
+            t_prev: e0.normalize(),
+            a: normal(&t1, rng.vector()),
+            t: e1.normalize(),
+            reference_twist: 3.0 * rng.next()
+                + 2.0 * std::f64::consts::PI * (2.0 * rng.next()).round(),
+        };
+        let q = [
+            e0.x,
+            e0.y,
+            e0.z,
+            e1.x,
+            e1.y,
+            e1.z,
+            3.0 * rng.next(),
+            3.0 * rng.next(),
+        ];
+        (q, c)
+    }
+
+    /// A rod of `law` with N = `segments` and stiffnesses of no symmetry.
+    fn model(law: Law, segments: usize) -> RodModel {
+        RodModel {
+            segments,
+            k2: 2.3,
+            k3: 1.7,
+            stretching_stiffness: 50.0,
+            law,
+            weight: [0.0; 3],
+            natural_strains: Default::default(),
+        }
+    }
+
+    /// Largest difference over the largest entry of the oracle.
+    fn relative(a: &[f64], oracle: &[f64]) -> f64 {
+        let scale = oracle.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = a
+            .iter()
+            .zip(oracle)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        diff / scale.max(f64::MIN_POSITIVE)
+    }
+
+    #[test]
+    fn closed_form_strain_derivatives_match_jets() {
+        let mut rng = Rng(7);
+        let mut worst: f64 = 0.0;
+        for _ in 0..500 {
+            let (q, c) = random_stencil(&mut rng);
+            let (s, chart) = vertex_chart(&q, &c).expect("a stencil at its own frames");
+            let jets = strain_jets(q, &c);
+            let derivatives = chart.strains();
+            for (k, (value, jet)) in [(s.k1, jets.k1), (s.k2, jets.k2), (s.m, jets.m)]
+                .into_iter()
+                .enumerate()
+            {
+                assert!((value - jet.v).abs() < 1e-12 * (1.0 + jet.v.abs()));
+                let (g, h) = chart.hessian(&derivatives[k]);
+                let gradient = relative(&g, &jet.g);
+                let hessian = relative(h.as_flattened(), jet.dense_hessian().as_flattened());
+                if k == 2 {
+                    // the published twist gradient ∂m/∂e_k = κb / (2 |e_k|)
+                    // (Bergou et al. 2010), which this convention keeps
+                    let edges = [[q[0], q[1], q[2]], [q[3], q[4], q[5]]];
+                    let lengths = edges.map(frames::norm);
+                    let tangents = [0, 1].map(|k| frames::scale(lengths[k].recip(), edges[k]));
+                    let kb = curvature_binormal(tangents[0], tangents[1]);
+                    for e in 0..2 {
+                        for r in 0..3 {
+                            let published = kb[r] / (2.0 * lengths[e]);
+                            assert!(
+                                (g[3 * e + r] - published).abs() < 1e-12 * (1.0 + published.abs())
+                            );
+                        }
+                    }
+                }
+                assert_eq!(chart.gradient(&derivatives[k].g), g);
+                assert_eq!(chart.strain_gradients()[k], derivatives[k].g);
+                assert!(gradient < 1e-10, "strain {k}: gradient off by {gradient:e}");
+                assert!(hessian < 1e-10, "strain {k}: Hessian off by {hessian:e}");
+                worst = worst.max(gradient).max(hessian);
+            }
+        }
+        eprintln!("strains: closed form vs jets, largest relative difference {worst:e}");
+    }
+
+    #[test]
+    fn closed_form_energy_hessian_matches_jets_for_every_law() {
+        let laws = [
+            Law::Kirchhoff,
+            Law::Unbendable,
+            Law::Strip {
+                regularisation: 0.3,
+            },
+        ];
+        let term_sets = [Terms::ALL, Terms::BENDING, Terms::TWISTING];
+        let mut rng = Rng(11);
+        let mut worst: f64 = 0.0;
+        for law in laws {
+            for terms in term_sets {
+                for _ in 0..100 {
+                    let model = model(law, 5);
+                    let natural = [rng.next(), 2.0 * rng.next(), 3.0 * rng.next()];
+                    let multiplier = law.constrained().then(|| VertexMultiplier {
+                        lambda: 3.0 * rng.next(),
+                        penalty: PENALTY * 5.0,
+                    });
+                    let (q, c) = random_stencil(&mut rng);
+                    assert!(vertex_chart(&q, &c).is_some());
+                    let args = ((&model, natural), terms, multiplier);
+                    let (e, g, h) = vertex_energy_hessian(q, &c, args.0, args.1, args.2);
+                    let (e_jet, g_jet, h_jet) =
+                        vertex_energy_hessian_by_jets(q, &c, args.0, args.1, args.2);
+                    assert!((e - e_jet).abs() <= 1e-12 * e_jet.abs().max(1e-300));
+                    let (e_grad, g_grad) = vertex_energy_gradient(q, &c, args.0, args.1, args.2);
+                    let (_, g_grad_jet) =
+                        jet::gradient(q, |v| vertex_energy(v, &c, args.0, args.1, args.2));
+                    assert_eq!(e_grad, e);
+                    let gradient = relative(&g_grad, &g_grad_jet);
+                    assert!(
+                        gradient < 1e-10,
+                        "{law:?}: gradient alone off by {gradient:e}"
+                    );
+                    worst = worst.max(gradient);
+                    let gradient = relative(&g, &g_jet);
+                    let hessian = relative(h.as_flattened(), h_jet.as_flattened());
+                    assert!(gradient < 1e-10, "{law:?}: gradient off by {gradient:e}");
+                    assert!(hessian < 1e-10, "{law:?}: Hessian off by {hessian:e}");
+                    worst = worst.max(gradient).max(hessian);
+                }
+            }
+        }
+        eprintln!("energy: closed form vs jets, largest relative difference {worst:e}");
+    }
+
+    #[test]
+    fn the_rods_own_states_take_the_closed_form_at_every_vertex() {
+        // the frame update re-normalises each transported reference director
+        // against its tangent; the clamp edges take theirs from the clamp,
+        // normal to the clamp's tangent up to the round-off of x_{N+1} − x_N
+        for (n, ends) in [
+            (12, Ends::CLAMPED),
+            (
+                40,
+                Ends {
+                    start: EndKind::Pinned,
+                    end: EndKind::Free,
+                },
+            ),
+            (3200, Ends::CLAMPED),
+        ] {
+            let mut clamps = Clamps::new(0.4, 0.1, 0.37);
+            clamps.ends = ends;
+            let base = RodState::straight(n, clamps);
+            let map = RodEnergy::with_ends(model(Law::Kirchhoff, n), Terms::ALL, ends).map;
+            let mut rng = Rng(5);
+            let dq: Vec<f64> = (0..map.len())
+                .map(|d| if map.is_translation(d) { 0.3 / n as f64 } else { 0.5 } * rng.next())
+                .collect();
+            let state = base.displaced(&map, &dq).displaced(&map, &dq);
+            for i in 1..=n {
+                let q = vertex_variables(&state, i);
+                assert!(
+                    vertex_chart(&q, &VertexFrames::at(&state, i)).is_some(),
+                    "N = {n}, vertex {i}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_reference_director_off_its_edge_falls_back_to_jets() {
+        let mut rng = Rng(3);
+        let (q, mut c) = random_stencil(&mut rng);
+        // a node moved after the frames were transported: the stored
+        // reference director no longer normal to the current tangent
+        c.a = (c.a + 1e-3 * c.t).normalize();
+        assert!(vertex_chart(&q, &c).is_none());
+        let model = model(Law::Kirchhoff, 5);
+        let args = ((&model, [0.3, -0.2, 0.5]), Terms::ALL, None);
+        assert_eq!(
+            vertex_energy_hessian(q, &c, args.0, args.1, args.2),
+            vertex_energy_hessian_by_jets(q, &c, args.0, args.1, args.2)
+        );
+    }
 }

@@ -12,5 +12,6 @@ pub mod natural;
 pub mod ode;
 pub mod rod;
 pub mod shooting;
+pub mod strain_hessian;
 pub mod strip_shooting;
 pub mod trefoil;
