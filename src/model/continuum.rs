@@ -158,61 +158,46 @@ fn integrate<const D: usize>(
     tolerance: f64,
     samples: usize,
 ) -> Result<Integrated<D>, ContinuumError> {
-    let start = ode_solvers::SVector::<f64, D>::from_column_slice(y0.as_slice());
-    let run = |dense: bool| {
-        let dx = if dense {
-            1.0 / (samples - 1) as f64
-        } else {
-            1.0
-        };
-        let mut solver = Dop853::new(Rhs(&f), 0.0, 1.0, dx, start, tolerance, tolerance);
-        // (Dense is the crate's default; Sparse ends on the last step's y(1))
-        solver.set_output(if dense {
-            OutputType::Dense
-        } else {
-            OutputType::Sparse
-        });
-        let stats = solver
-            .integrate()
-            .map_err(|e| ContinuumError::Integration {
-                s: match e {
-                    ode_solvers::dop_shared::IntegrationError::MaxNumStepReached { x, .. }
-                    | ode_solvers::dop_shared::IntegrationError::StepSizeUnderflow { x }
-                    | ode_solvers::dop_shared::IntegrationError::StiffnessDetected { x } => x,
-                },
-                reason: e.to_string(),
-            })?;
-        let ys: Vec<SVector<f64, D>> = solver
-            .y_out()
-            .iter()
-            .map(|y| SVector::from_column_slice(y.as_slice()))
-            .collect();
-        Ok::<_, ContinuumError>((ys, stats.accepted_steps))
-    };
-    let (ys, steps) = run(false)?;
-    let end = *ys.last().ok_or(ContinuumError::Integration {
-        s: 0.0,
-        reason: "no step".into(),
-    })?;
-    if end.iter().any(|v| !v.is_finite()) {
-        return Err(ContinuumError::Integration {
-            s: 1.0,
-            reason: "the solution is not finite".into(),
-        });
+    let (ends, steps) = integrate_stops(y0, &f, tolerance, &[1.0])?;
+    let end = ends[0];
+    if samples < 2 {
+        return Ok((end, vec![], steps));
     }
-    let mut dense = if samples >= 2 { run(true)?.0 } else { vec![] };
+    let start = ode_solvers::SVector::<f64, D>::from_column_slice(y0.as_slice());
+    let dx = 1.0 / (samples - 1) as f64;
+    // (Dense is the crate's default output)
+    let mut solver = Dop853::new(Rhs(&f), 0.0, 1.0, dx, start, tolerance, tolerance);
+    solver.integrate().map_err(integration_error)?;
+    let mut dense: Vec<SVector<f64, D>> = solver
+        .y_out()
+        .iter()
+        .map(|y| SVector::from_column_slice(y.as_slice()))
+        .collect();
     // the crate's dense output at s = 1 itself is an extrapolation (errors
     // of 1e-10 seen); the step's own y(1) is exact to the tolerance
     if let Some(last) = dense.last_mut() {
         *last = end;
     }
-    if samples >= 2 && dense.len() != samples {
+    if dense.len() != samples {
         return Err(ContinuumError::Integration {
             s: 1.0,
             reason: format!("dense output gave {} samples, not {samples}", dense.len()),
         });
     }
     Ok((end, dense, steps))
+}
+
+/// The integrator's failure, with where it stopped.
+fn integration_error(e: ode_solvers::dop_shared::IntegrationError) -> ContinuumError {
+    use ode_solvers::dop_shared::IntegrationError as E;
+    ContinuumError::Integration {
+        s: match e {
+            E::MaxNumStepReached { x, .. }
+            | E::StepSizeUnderflow { x }
+            | E::StiffnessDetected { x } => x,
+        },
+        reason: e.to_string(),
+    }
 }
 
 /// y at each of the increasing `stops` in (0, 1] of y' = f(s, y) from
@@ -223,10 +208,11 @@ pub(crate) fn integrate_stops<const D: usize>(
     f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
     tolerance: f64,
     stops: &[f64],
-) -> Result<Vec<SVector<f64, D>>, ContinuumError> {
+) -> Result<(Vec<SVector<f64, D>>, u32), ContinuumError> {
     let mut y = ode_solvers::SVector::<f64, D>::from_column_slice(y0.as_slice());
     let mut from = 0.0;
     let mut out = Vec::with_capacity(stops.len());
+    let mut steps = 0;
     for &to in stops {
         if !(to >= from && to <= 1.0) {
             return Err(ContinuumError::Integration {
@@ -255,18 +241,10 @@ pub(crate) fn integrate_stops<const D: usize>(
                 1000,
                 OutputType::Sparse,
             );
-            solver
+            steps += solver
                 .integrate()
-                .map_err(|e| ContinuumError::Integration {
-                    s: match e {
-                        ode_solvers::dop_shared::IntegrationError::MaxNumStepReached {
-                            x, ..
-                        }
-                        | ode_solvers::dop_shared::IntegrationError::StepSizeUnderflow { x }
-                        | ode_solvers::dop_shared::IntegrationError::StiffnessDetected { x } => x,
-                    },
-                    reason: e.to_string(),
-                })?;
+                .map_err(integration_error)?
+                .accepted_steps;
             y = *solver.y_out().last().ok_or(ContinuumError::Integration {
                 s: from,
                 reason: "no step".into(),
@@ -281,7 +259,7 @@ pub(crate) fn integrate_stops<const D: usize>(
         out.push(SVector::from_column_slice(y.as_slice()));
         from = to;
     }
-    Ok(out)
+    Ok((out, steps))
 }
 
 fn check_finite(p: &Unknowns) -> Result<(), ContinuumError> {
@@ -460,7 +438,7 @@ impl Continuum {
         Ok(match self.law {
             ContinuumLaw::Kirchhoff { k2, k3 } => {
                 let f = |s: f64, y: &SVector<f64, ROD>| self.rod_rhs(s, y, k2, k3);
-                let ys = integrate_stops(self.rod_start(p), f, self.tolerance, stops)?;
+                let (ys, _) = integrate_stops(self.rod_start(p), f, self.tolerance, stops)?;
                 ys.iter()
                     .zip(stops)
                     .map(|(y, &s)| frame(y.as_slice(), f(s, y).as_slice()))
@@ -469,7 +447,7 @@ impl Continuum {
             ContinuumLaw::Strip { regularisation } => {
                 let f = |s: f64, y: &SVector<f64, STRIP>| self.strip_rhs(s, y, regularisation);
                 let y0 = self.strip_start(p, regularisation).0;
-                let ys = integrate_stops(y0, f, self.tolerance, stops)?;
+                let (ys, _) = integrate_stops(y0, f, self.tolerance, stops)?;
                 ys.iter()
                     .zip(stops)
                     .map(|(y, &s)| frame(y.as_slice(), f(s, y).as_slice()))
@@ -499,9 +477,8 @@ impl Continuum {
         };
         let mut y0 = SVector::<f64, VARIATIONAL>::zeros();
         y0.fixed_rows_mut::<19>(0)
-            .copy_from(&start_frame(&self.clamps));
+            .copy_from(&self.rod_start(p).fixed_rows::<19>(0));
         for c in 0..6 {
-            y0[12 + c] = p[c];
             // ∂y(0)/∂p_c: the unit vector of n(0) or m(0)'s component c
             y0[19 * (c + 1) + 12 + c] = 1.0;
         }
@@ -522,7 +499,7 @@ impl Continuum {
             }
             dy
         };
-        let end = integrate_stops(y0, f, self.tolerance, &[1.0])?[0];
+        let end = integrate_stops(y0, f, self.tolerance, &[1.0])?.0[0];
         let core: OdeState = end.fixed_rows::<19>(0).into();
         let residual_of = |y: &OdeState| {
             self.end_residual(

@@ -163,8 +163,8 @@ impl<'a> ContinuumBranch<'a> {
         Ok((r, jac))
     }
 
-    /// The unit tangent of the branch at z (the null vector of the 6×7
-    /// Jacobian), oriented along `towards` if given.
+    /// A unit tangent of the branch at z (the null vector of the 6×7
+    /// Jacobian; its sign is arbitrary).
     pub fn tangent(&self, z: &BranchPoint) -> Result<BranchPoint, BranchError> {
         let (_, jac) = self.linearise(z)?;
         null_vector(&jac).ok_or(BranchError::Continuum(ContinuumError::Singular))
