@@ -27,20 +27,11 @@ import numpy as np
 AUTO_DIR = os.environ.get("AUTO_DIR", "/usr/lib/auto-07p")
 HERE = os.path.dirname(os.path.abspath(__file__))
 
-K2 = K3 = 3.0
-ZSTAR, DELTA, PHI0 = 0.115, 0.05, 0.802
-N0 = np.array([-24.743, 17.772, 37.145])
-M0 = np.array([7.5317, -8.7100, 4.529])
-
+sys.path.insert(0, os.path.join(HERE, ".."))
+from paper_rod import DELTA, ZSTAR, PHI0_OVER_2PI as PHI0, N0, M0, rhs  # noqa: E402
 
 # --------------------------------------------------------------------------
 # the start: (A.2) integrated from s = 0 (the paper's shooting data)
-def rhs(s, y):
-    d1, d2, d3, n, m = y[3:6], y[6:9], y[9:12], y[12:15], y[15:18]
-    u = np.array([m[0], m[1] / K2, m[2] / K3])
-    return np.concatenate([d3, u[2] * d2 - u[1] * d3, u[0] * d3 - u[2] * d1,
-                           u[1] * d1 - u[0] * d2, np.cross(n, u),
-                           np.cross(m, u) + [n[1], -n[0], 0.0]])
 
 
 def end_conditions(y1, phi_over_2pi):

@@ -18,25 +18,19 @@ elements / Voronoi points) change by less than --tol over a check interval.
 usage: appendix_d.py --n 100 [--tol 1e-6] [--damping 40]  -> JSON on stdout
 """
 import argparse
+import os
 import json
+import sys
 import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-K2 = K3 = 3.0
-ZSTAR, DELTA, PHI = 0.115, 0.05, 2 * np.pi * 0.802
-N0 = np.array([-24.743, 17.772, 37.145])
-M0 = np.array([7.5317, -8.7100, 4.529])
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from paper_rod import K2, K3, ZSTAR, DELTA, PHI0_OVER_2PI, N0, M0, rhs  # noqa: E402
+
+PHI = 2 * np.pi * PHI0_OVER_2PI
 STIFF = 640000.0
-
-
-def rhs(s, y):
-    d1, d2, d3, n, m = y[3:6], y[6:9], y[9:12], y[12:15], y[15:18]
-    u = np.array([m[0], m[1] / K2, m[2] / K3])
-    return np.concatenate([d3, u[2] * d2 - u[1] * d3, u[0] * d3 - u[2] * d1,
-                           u[1] * d1 - u[0] * d2, np.cross(n, u),
-                           np.cross(m, u) + [n[1], -n[0], 0.0]])
 
 
 def main():
