@@ -286,6 +286,38 @@ fn print_traced(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
     if let Some(why) = &t.stopped {
         writeln!(out, "  walk stopped: {why}")?;
     }
+    if let Some(why) = &t.not_polished {
+        writeln!(out, "  not polished on the continuum: {why}")?;
+    }
+    if let Some(p) = &t.polished {
+        writeln!(
+            out,
+            "  polished on the continuum (tolerance {:.0e}): area {:.7} ± {:.1e} (polygon {:.7}), \
+             points to {:.1e}, largest discrete − continuum {:.2e}",
+            p.tolerance,
+            p.area,
+            p.area_error,
+            p.area_polygon,
+            p.largest_point_error,
+            p.largest_shift
+        )?;
+        for c in &p.corners {
+            writeln!(
+                out,
+                "    corner {}/{} at ({:.7}, {:.7}) ± {:.1e} (discrete ({:.5}, {:.5}))",
+                c.between[0],
+                c.between[1],
+                c.point[0],
+                c.point[1],
+                c.error,
+                c.discrete[0],
+                c.discrete[1]
+            )?;
+        }
+        for d in &p.dropped {
+            writeln!(out, "    left out: {d}")?;
+        }
+    }
     Ok(())
 }
 

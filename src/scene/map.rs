@@ -28,6 +28,10 @@ pub struct MapSpec {
     /// parameter) plane.
     #[serde(default = "default_trace_step")]
     pub trace_step: f64,
+    /// Polish the traced boundary on the continuum (its points, corners and
+    /// area, with error estimates).
+    #[serde(default)]
+    pub polish: bool,
     /// A 3D map: one such map per value of a third parameter.
     #[serde(default)]
     pub slices: Option<SliceSpec>,

@@ -10,7 +10,7 @@ use crate::analysis::equilibrium::{Measure, self_approach};
 use crate::analysis::event::{ContinuumEvent, Event, EventKind};
 use crate::model::continuum::Unknowns;
 use crate::model::continuum_branch::{
-    BranchPoint, ContinuumBranch, PARAMETER, TestFunction, singular_borders,
+    BranchPoint, ContinuumBranch, Located, PARAMETER, TestFunction, singular_borders,
 };
 use crate::model::rod::{Parameter, RodModel, RodState};
 use rayon::prelude::*;
@@ -114,15 +114,7 @@ fn test_function(
     c: Class,
 ) -> Result<TestFunction, String> {
     match c {
-        Class::Singular => {
-            let p: Unknowns = z.fixed_rows::<6>(0).into();
-            let (_, j) = branch
-                .problem(z[PARAMETER])
-                .and_then(|pr| Ok(pr.linearise(&p)?))
-                .map_err(|e| e.to_string())?;
-            let (left, right) = singular_borders(&j).ok_or("no singular vectors")?;
-            Ok(TestFunction::Singular { left, right })
-        }
+        Class::Singular => singular_at(branch, z),
         Class::Wall => {
             // the interior node nearest a wall
             let (points, arc) = state.centreline();
@@ -188,23 +180,10 @@ fn polish_one(
         PARAMETER
     };
     let test = test_function(&branch, &z, state, measure, c)?;
-    let scale = 1.0 + z[held].abs();
-    // at a fold the parameter is stationary in the held unknown: an error δ
-    // there moves it by O(δ²), so δ = 1e-7 suffices (and the test
-    // function's noise forbids much less)
-    let resolution = if held == PARAMETER { 1e-10 } else { 1e-7 } * scale;
-    let coarse = branch
-        .locate(z, held, 1e-4 * scale, resolution, test)
-        .map_err(|e| e.to_string())?;
-    // the same root at a hundredth of the tolerance, from the first
-    let fine_branch = branch.with_tolerance(POLISH_TOLERANCE * 1e-2);
-    let step = (10.0 * coarse.last_step.abs()).max(1e-8 * scale);
-    let fine = fine_branch
-        .locate(coarse.point, held, step, resolution, coarse.test.clone())
-        .map_err(|e| e.to_string())?;
+    let root = locate_root(&branch, z, held, test)?;
+    let fine = &root.fine;
     let value = fine.point[PARAMETER];
-    let error = (coarse.point[PARAMETER] - value).abs()
-        + (fine.point[PARAMETER] - fine.previous[PARAMETER]).abs();
+    let fine_branch = branch.with_tolerance(POLISH_TOLERANCE * 1e-2);
     let p: Unknowns = fine.point.fixed_rows::<6>(0).into();
     let twist = fine_branch
         .problem(value)
@@ -219,11 +198,73 @@ fn polish_one(
     Ok(ContinuumEvent {
         parameter,
         value,
-        error,
+        error: root.error,
         discrete_minus_continuum: discrete - value,
         twist,
         unknowns: [p[0], p[1], p[2], p[3], p[4], p[5]],
         arclengths,
-        steps: coarse.steps + fine.steps,
+        steps: root.steps,
     })
+}
+
+/// A test function's root on a continuum branch, located at
+/// [`POLISH_TOLERANCE`] and again at a hundredth of it.
+pub(crate) struct Root {
+    /// Its error estimate in the parameter: the change with the tolerance
+    /// plus the last secant step.
+    pub error: f64,
+    /// The root located at the finer tolerance (with its updated test).
+    pub fine: Located,
+    /// Secant steps of both passes.
+    pub steps: usize,
+}
+
+/// The root of `test` on `branch` from `z`, holding coordinate `held`
+/// (the parameter, or at a fold an unknown), located twice for its error.
+pub(crate) fn locate_root(
+    branch: &ContinuumBranch,
+    z: BranchPoint,
+    held: usize,
+    test: TestFunction,
+) -> Result<Root, String> {
+    let scale = 1.0 + z[held].abs();
+    // at a fold the parameter is stationary in the held unknown: an error δ
+    // there moves it by O(δ²), so δ = 1e-7 suffices (and the test
+    // function's noise forbids much less)
+    let resolution = if held == PARAMETER {
+        branch.tolerance
+    } else {
+        1e-7
+    } * scale;
+    let coarse = branch
+        .locate(z, held, 1e-4 * scale, resolution, test)
+        .map_err(|e| e.to_string())?;
+    // the same root at a hundredth of the tolerance, from the first
+    let fine_branch = branch.with_tolerance(branch.tolerance * 1e-2);
+    let step = (10.0 * coarse.last_step.abs()).max(1e-8 * scale);
+    let fine = fine_branch
+        .locate(coarse.point, held, step, resolution, coarse.test.clone())
+        .map_err(|e| e.to_string())?;
+    let error = (coarse.point[PARAMETER] - fine.point[PARAMETER]).abs()
+        + (fine.point[PARAMETER] - fine.previous[PARAMETER]).abs();
+    Ok(Root {
+        error,
+        steps: coarse.steps + fine.steps,
+        fine,
+    })
+}
+
+/// The bordered-determinant test of a singular shooting Jacobian, its
+/// borders the singular vectors of the smallest singular value at z.
+pub(crate) fn singular_at(
+    branch: &ContinuumBranch,
+    z: &BranchPoint,
+) -> Result<TestFunction, String> {
+    let p: Unknowns = z.fixed_rows::<6>(0).into();
+    let (_, j) = branch
+        .problem(z[PARAMETER])
+        .and_then(|pr| Ok(pr.linearise(&p)?))
+        .map_err(|e| e.to_string())?;
+    let (left, right) = singular_borders(&j).ok_or("no singular vectors")?;
+    Ok(TestFunction::Singular { left, right })
 }

@@ -19,12 +19,15 @@
 //! property fails, until it closes on its start.
 //!
 //! `condition` defines the conditions, `walk` the continuation round the
-//! region, `traced` names the pieces and measures the loop.
+//! region, `traced` names the pieces and measures the loop, `polish` locates
+//! the loop again on the continuum (`[map] polish = true`).
 
 mod condition;
+mod polish;
 mod traced;
 mod walk;
 
 pub use condition::{Condition, OtherStrand, Strands};
+pub use polish::{PolishedBoundary, PolishedCorner};
 pub use traced::{GridCheck, Piece, Traced};
 pub use walk::trace_island;

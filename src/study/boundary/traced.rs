@@ -1,15 +1,28 @@
 //! The traced boundary: the walk's pieces named as the paper does (W1, W2,
 //! X1, X2, S), the loop's area and extent.
 
-use crate::model::rod::Parameter;
+use crate::model::rod::{Parameter, RodState};
 use crate::study::boundary::condition::Condition;
+use crate::study::boundary::polish::PolishedBoundary;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// A piece of the walk: its condition, and its points with the component
-/// along the lines (the continuation's parameter) of the condition's unit
-/// gradient (positive: the good side lies above).
-pub(super) type Trail = (Condition, Vec<([f64; 2], f64)>);
+/// A point of the walk on one condition.
+#[derive(Clone, Debug)]
+pub(super) struct TrailPoint {
+    /// (swept parameter, value along the lines).
+    pub at: [f64; 2],
+    /// The condition's unit gradient in the plane (towards the good side);
+    /// its component along the lines (the continuation's parameter) is
+    /// positive where the good side lies above.
+    pub normal: [f64; 2],
+    /// The discrete equilibrium there, the polish's start (absent in trails
+    /// made by hand).
+    pub state: Option<RodState>,
+}
+
+/// A piece of the walk: its condition and its points.
+pub(super) type Trail = (Condition, Vec<TrailPoint>);
 
 /// One piece of the traced boundary: a polyline on one condition.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -57,6 +70,12 @@ pub struct Traced {
     /// Comparison with the grid's good intervals.
     #[serde(default)]
     pub grid_check: Option<GridCheck>,
+    /// The boundary polished on the continuum (`[map] polish = true`).
+    #[serde(default)]
+    pub polished: Option<PolishedBoundary>,
+    /// Why the polish failed, if it did.
+    #[serde(default)]
+    pub not_polished: Option<String>,
 }
 
 impl Traced {
@@ -86,6 +105,8 @@ impl Traced {
             equilibria: 0,
             stopped: Some(why),
             grid_check: None,
+            polished: None,
+            not_polished: None,
         }
     }
 }
@@ -96,6 +117,22 @@ fn same_crossing(a: &Condition, b: &Condition) -> bool {
         (Condition::Crossing(a), Condition::Crossing(b)) => a.near(b.first, b.other),
         _ => false,
     }
+}
+
+/// A crossing followed across neighbouring segment pairs (a corner where
+/// the knot test flickered at a sharp tip) is one curve: such consecutive
+/// pieces are joined.
+pub(super) fn merge_crossings(mut pieces: Vec<Trail>) -> Vec<Trail> {
+    let mut k = 1;
+    while k < pieces.len() {
+        if same_crossing(&pieces[k - 1].0, &pieces[k].0) {
+            let next = pieces.remove(k);
+            pieces[k - 1].1.extend(next.1.into_iter().skip(1));
+        } else {
+            k += 1;
+        }
+    }
+    pieces
 }
 
 /// The paper's name of a piece: walls are W1 where the good region lies
@@ -117,18 +154,7 @@ pub(super) fn name_pieces(
     closed: bool,
     stopped: Option<String>,
 ) -> Traced {
-    // a crossing followed across neighbouring segment pairs (a corner where
-    // the knot test flickered at a sharp tip) is one curve
-    let mut pieces = pieces;
-    let mut k = 1;
-    while k < pieces.len() {
-        if same_crossing(&pieces[k - 1].0, &pieces[k].0) {
-            let next = pieces.remove(k);
-            pieces[k - 1].1.extend(next.1.into_iter().skip(1));
-        } else {
-            k += 1;
-        }
-    }
+    let pieces = merge_crossings(pieces);
     // split the pieces where their name changes (a wall curve turning round
     // the island's tip is W1 on one side and W2 on the other)
     let mut named: Vec<Piece> = Vec::new();
@@ -138,8 +164,9 @@ pub(super) fn name_pieces(
             condition: c.describe(),
             points: vec![p],
         };
-        let mut current = piece(label(c, points[0].1), points[0].0);
-        for (k, &(p, side)) in points.iter().enumerate().skip(1) {
+        let mut current = piece(label(c, points[0].normal[1]), points[0].at);
+        for (k, &TrailPoint { at: p, normal, .. }) in points.iter().enumerate().skip(1) {
+            let side = normal[1];
             current.points.push(p);
             // the piece's last point (a corner or the walk's start) keeps
             // its piece's name; elsewhere a change of side starts a new one
@@ -188,6 +215,8 @@ pub(super) fn name_pieces(
         equilibria,
         stopped,
         grid_check: None,
+        polished: None,
+        not_polished: None,
     };
     let all = traced.polygon();
     traced.area = closed.then(|| {
@@ -215,19 +244,28 @@ mod tests {
     fn a_wall_curve_round_the_tip_is_w1_on_one_side_and_w2_on_the_other() {
         // a closed walk starting on the wall's upper side (good side below,
         // W2), round the tip (W1), then a stability curve back to the start
+        let points = |p: &[([f64; 2], f64)]| {
+            p.iter()
+                .map(|&(at, side): &([f64; 2], f64)| TrailPoint {
+                    at,
+                    normal: [(1.0 - side * side).sqrt(), side],
+                    state: None,
+                })
+                .collect::<Vec<_>>()
+        };
         let trail: Vec<Trail> = vec![
             (
                 Condition::Wall,
-                vec![
+                points(&[
                     ([0.2, 0.9], -0.5),
                     ([0.1, 0.8], -0.2),
                     ([0.1, 0.7], 0.3),
                     ([0.2, 0.6], 0.6),
-                ],
+                ]),
             ),
             (
                 Condition::Stability,
-                vec![([0.2, 0.6], 0.1), ([0.3, 0.8], 0.1), ([0.2, 0.9], 0.1)],
+                points(&[([0.2, 0.6], 0.1), ([0.3, 0.8], 0.1), ([0.2, 0.9], 0.1)]),
             ),
         ];
         let t = name_pieces([Parameter::ZStar, Parameter::Phi], 7, trail, true, None);

@@ -12,7 +12,8 @@ use crate::solve::step::StepControl;
 use crate::study::boundary::condition::{
     Condition, Failure, OtherStrand, Strands, closest_strands, strand_distance,
 };
-use crate::study::boundary::traced::{Traced, Trail, name_pieces};
+use crate::study::boundary::polish::polish_boundary;
+use crate::study::boundary::traced::{Traced, Trail, TrailPoint, merge_crossings, name_pieces};
 use crate::study::error::{Context, Result, describe, fail};
 use crate::study::start::starting_equilibrium;
 
@@ -437,13 +438,23 @@ pub fn trace_island(
     let outcome = walk_around(&mut walk, start, &mut pieces, on_point);
     let stopped = outcome.err().map(|e| describe(&e));
     let closed = stopped.is_none();
-    Ok(name_pieces(
-        [swept, along],
-        walk.equilibria,
-        pieces,
-        closed,
-        stopped,
-    ))
+    let pieces = merge_crossings(pieces);
+    let polished = (closed && spec.polish).then(|| {
+        polish_boundary(
+            &walk.tracer.newton.energy.model,
+            [swept, along],
+            base,
+            &pieces,
+            spec.trace_step,
+        )
+    });
+    let mut traced = name_pieces([swept, along], walk.equilibria, pieces, closed, stopped);
+    match polished {
+        Some(Ok(p)) => traced.polished = Some(p),
+        Some(Err(why)) => traced.not_polished = Some(why),
+        None => {}
+    }
+    Ok(traced)
 }
 
 /// Walk round the good region from `start`: up along the lines (p[1]) to
@@ -467,7 +478,14 @@ fn walk_around(
         stuck: 0,
         tried: Vec::new(),
     };
-    pieces.push((tour.c, vec![(tour.first, unit(tour.at.gradient)[1])]));
+    pieces.push((
+        tour.c,
+        vec![TrailPoint {
+            at: tour.first,
+            normal: unit(tour.at.gradient),
+            state: Some(tour.at.site.point.state.clone()),
+        }],
+    ));
     loop {
         tour.check_budget(walk)?;
         let t = left_tangent(tour.at.gradient);
@@ -485,12 +503,16 @@ fn walk_around(
         match walk.failing(&q, Some(&tour.c), unit(g))? {
             None => {
                 if tour.closes(&q, t) {
-                    let side = pieces[0].1[0].1;
-                    pieces.last_mut().unwrap().1.push((tour.first, side));
+                    let first = pieces[0].1[0].clone();
+                    pieces.last_mut().unwrap().1.push(first);
                     return Ok(());
                 }
                 let piece = pieces.last_mut().unwrap();
-                piece.1.push((q.on, unit(g)[1]));
+                piece.1.push(TrailPoint {
+                    at: q.on,
+                    normal: unit(g),
+                    state: Some(q.point.state.clone()),
+                });
                 tour.count += 1;
                 on_point(tour.count, &piece.0.describe());
                 tour.at = Step {
@@ -662,8 +684,12 @@ impl Tour {
             );
         }
         let corner = good.on;
-        let old = unit(walk.gradient(&mut self.c, &good)?)[1];
-        pieces.last_mut().unwrap().1.push((corner, old));
+        let old = unit(walk.gradient(&mut self.c, &good)?);
+        pieces.last_mut().unwrap().1.push(TrailPoint {
+            at: corner,
+            normal: old,
+            state: Some(good.point.state.clone()),
+        });
         let mut c = walk.condition_of(failure, &bad, &self.tried);
         walk.orient_at(&mut c, &self.at.site)?;
         let mut gradient = walk.gradient(&mut c, &good)?;
@@ -676,7 +702,14 @@ impl Tour {
             s.sign = -s.sign;
             gradient = [-gradient[0], -gradient[1]];
         }
-        pieces.push((c, vec![(corner, unit(gradient)[1])]));
+        pieces.push((
+            c,
+            vec![TrailPoint {
+                at: corner,
+                normal: unit(gradient),
+                state: Some(good.point.state.clone()),
+            }],
+        ));
         self.count += 1;
         self.c = c;
         self.at = Step {

@@ -1,0 +1,793 @@
+//! The traced boundary polished on the continuum: every point of the walk
+//! located again as the root of its condition's continuum test function on
+//! the line of the plane through it that crosses the curve most steeply
+//! (held swept parameter, free value along the lines, or the other way
+//! round), every corner as the root of the next condition's test along the
+//! previous condition's curve, and a point polished between each pair of
+//! neighbours, so that the area has an N-independent value and a
+//! Richardson error estimate from nested point sets.
+
+use crate::model::continuum_branch::{BranchPoint, ContinuumBranch, PARAMETER, TestFunction};
+use crate::model::rod::{Clamps, Parameter, RodModel, RodState};
+use crate::study::boundary::condition::{Condition, OtherStrand};
+use crate::study::boundary::traced::{Piece, Trail, TrailPoint, name_pieces};
+use crate::study::polish::{discrete_unknowns, locate_root, singular_at};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Integrator tolerance of the boundary's polish: its points to about
+/// 1e-8, far below what the area's 1e-4 relative error needs.
+pub const BOUNDARY_TOLERANCE: f64 = 1e-8;
+
+/// A corner of the polished boundary.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PolishedCorner {
+    /// The pieces it joins, in walk order.
+    pub between: [String; 2],
+    /// (swept parameter, value along) on the continuum.
+    pub point: [f64; 2],
+    /// Error estimate of either coordinate (the change when the
+    /// integrator's tolerance falls a hundredfold, plus the last steps).
+    pub error: f64,
+    /// The discrete rod's corner (the walk's).
+    pub discrete: [f64; 2],
+}
+
+/// The traced boundary on the continuum.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PolishedBoundary {
+    /// The pieces, named as the traced ones: the walk's points and one
+    /// between each pair of neighbours, polished.
+    pub pieces: Vec<Piece>,
+    /// The corners.
+    pub corners: Vec<PolishedCorner>,
+    /// Enclosed area, Richardson-extrapolated from the polygons of all the
+    /// points and of the walk's points alone.
+    pub area: f64,
+    /// Its error estimate: the extrapolation's change from the walk's
+    /// points and every other one of them, plus the points' own errors
+    /// along the perimeter.
+    pub area_error: f64,
+    /// The shoelace area of the polygon of all the points (no
+    /// extrapolation).
+    pub area_polygon: f64,
+    /// Largest error estimate of a point's polished coordinate.
+    pub largest_point_error: f64,
+    /// Largest |discrete − continuum| of a walk point along its line: the
+    /// discrete rod's error at its N.
+    pub largest_shift: f64,
+    /// Integrator tolerance of the polish (its errors from a second pass at
+    /// a hundredth of it).
+    pub tolerance: f64,
+    /// Walk points the polish could not locate (left out, their
+    /// neighbours' middle polished instead), and why.
+    pub dropped: Vec<String>,
+}
+
+/// A point of the boundary on the continuum.
+#[derive(Clone, Debug)]
+struct Polished {
+    /// (swept, along).
+    at: [f64; 2],
+    /// Error estimate of the free coordinate.
+    error: f64,
+    /// The continuum solution: the unknowns and the free coordinate.
+    z: BranchPoint,
+    /// The free coordinate of the plane (0 swept, 1 along).
+    free: usize,
+    /// The test at the root (arclengths updated).
+    test: TestFunction,
+    /// The condition's unit gradient, as at the walk's point it came from.
+    normal: [f64; 2],
+}
+
+/// The plane of the walk, on the continuum.
+struct Plane<'a> {
+    model: &'a RodModel,
+    params: [Parameter; 2],
+    /// The clamps of the other parameters.
+    base: Clamps,
+    /// The walk's largest step: how far apart the points may lie, and about
+    /// how far the polish may move one.
+    spacing: f64,
+}
+
+/// The free coordinate of a line crossing a curve of unit normal `normal`:
+/// the one the normal leans along.
+fn free_of(normal: [f64; 2]) -> usize {
+    usize::from(normal[1].abs() >= normal[0].abs())
+}
+
+/// Of several roots of a condition on one line, the boundary's: the first
+/// met coming from the good side (along −normal).
+fn first_from_good_side(roots: Vec<Polished>) -> Option<Polished> {
+    roots.into_iter().max_by(|a, b| {
+        let n = a.normal[a.free];
+        (n * a.at[a.free]).total_cmp(&(n * b.at[b.free]))
+    })
+}
+
+impl Plane<'_> {
+    fn clamps(&self, at: [f64; 2]) -> Clamps {
+        self.params[0].with(&self.params[1].with(&self.base, at[1]), at[0])
+    }
+
+    /// The continuum line through `at` free in coordinate `free`.
+    fn line(
+        &self,
+        at: [f64; 2],
+        free: usize,
+        tolerance: f64,
+    ) -> Result<ContinuumBranch<'_>, String> {
+        ContinuumBranch::new(self.model, self.clamps(at), self.params[free], tolerance)
+            .map_err(|e| e.to_string())
+    }
+
+    /// The continuum test functions of condition `c` at the discrete `state`
+    /// (z: its shooting unknowns on `branch`): for walls one per wall (the
+    /// interior extremum nearest each), since near a flip-symmetric knot
+    /// both are touched almost at once and the continuum may touch the
+    /// other first.
+    fn tests_of(
+        &self,
+        branch: &ContinuumBranch,
+        z: &BranchPoint,
+        state: &RodState,
+        c: &Condition,
+    ) -> Result<Vec<TestFunction>, String> {
+        match c {
+            Condition::Wall => {
+                let (points, arc) = state.centreline();
+                let (origin, axis) = (state.clamps.start_point(), state.clamps.start_tangent());
+                let interior = 1..=state.segments().min(points.len() - 2);
+                Ok([0.0, state.clamps.top_wall()]
+                    .into_iter()
+                    .filter_map(|wall| {
+                        interior
+                            .clone()
+                            .min_by(|&i, &j| {
+                                let gap = |k: usize| ((points[k] - origin).dot(&axis) - wall).abs();
+                                gap(i).total_cmp(&gap(j))
+                            })
+                            .map(|i| TestFunction::Wall { wall, s: arc[i] })
+                    })
+                    .collect())
+            }
+            Condition::Stability => Ok(vec![singular_at(branch, z)?]),
+            Condition::Crossing(s) => {
+                let OtherStrand::Segment(j) = s.other else {
+                    return Err("a crossing of a clamp's ray is not polished".into());
+                };
+                let (points, arc) = state.centreline();
+                let i = s.first;
+                if j + 1 >= points.len() {
+                    return Err(format!("no segment {j} on the centreline"));
+                }
+                let (_, ta, tb) = crate::geometry::distance::segment_distance(
+                    &points[i],
+                    &points[i + 1],
+                    &points[j],
+                    &points[j + 1],
+                );
+                Ok(vec![TestFunction::Crossing {
+                    s: [
+                        arc[i] + ta * (arc[i + 1] - arc[i]),
+                        arc[j] + tb * (arc[j + 1] - arc[j]),
+                    ],
+                }])
+            }
+        }
+    }
+
+    /// The discrete equilibrium's point in the plane and its shooting
+    /// unknowns on the line free in `free`.
+    fn start(&self, state: &RodState, free: usize) -> ([f64; 2], BranchPoint) {
+        let at = [
+            self.params[0].value(&state.clamps),
+            self.params[1].value(&state.clamps),
+        ];
+        let mut z = BranchPoint::zeros();
+        z.fixed_rows_mut::<6>(0)
+            .copy_from(&discrete_unknowns(self.model, state));
+        z[PARAMETER] = at[free];
+        (at, z)
+    }
+
+    /// A walk point on its condition, polished on the line through it that
+    /// crosses the curve most steeply, else on the other line.
+    fn point(&self, p: &TrailPoint, c: &Condition) -> Result<Polished, String> {
+        let free = free_of(p.normal);
+        self.point_on(p, c, free).or_else(|first| {
+            self.point_on(p, c, 1 - free)
+                .map_err(|second| format!("{first}; across the other way: {second}"))
+        })
+    }
+
+    /// A walk point on its condition, polished on the line through it free
+    /// in coordinate `free`.
+    fn point_on(&self, p: &TrailPoint, c: &Condition, free: usize) -> Result<Polished, String> {
+        let state = p.state.as_ref().ok_or("no discrete equilibrium")?;
+        let (at, z) = self.start(state, free);
+        let branch = self.line(at, free, BOUNDARY_TOLERANCE)?;
+        let tests = self.tests_of(&branch, &z, state, c)?;
+        self.first_root(&branch, at, free, z, tests, p.normal, 2.0 * self.spacing)
+    }
+
+    /// The boundary's root on a line among those of `tests`, each within
+    /// `reach` of the start in the free coordinate (a root farther away is
+    /// another extremum's or another branch's).
+    #[allow(clippy::too_many_arguments)]
+    fn first_root(
+        &self,
+        branch: &ContinuumBranch,
+        at: [f64; 2],
+        free: usize,
+        z: BranchPoint,
+        tests: Vec<TestFunction>,
+        normal: [f64; 2],
+        reach: f64,
+    ) -> Result<Polished, String> {
+        let mut why = String::from("no test function");
+        let roots: Vec<Polished> = tests
+            .into_iter()
+            .filter_map(|t| match self.root_on(branch, at, free, z, t, normal) {
+                Ok(r) if (r.at[free] - at[free]).abs() <= reach => Some(r),
+                Ok(r) => {
+                    why = format!(
+                        "the root moved {:.2e} from its start, more than {reach:.2e}",
+                        (r.at[free] - at[free]).abs()
+                    );
+                    None
+                }
+                Err(e) => {
+                    why = e;
+                    None
+                }
+            })
+            .collect();
+        first_from_good_side(roots).ok_or(why)
+    }
+
+    fn root_on(
+        &self,
+        branch: &ContinuumBranch,
+        mut at: [f64; 2],
+        free: usize,
+        z: BranchPoint,
+        test: TestFunction,
+        normal: [f64; 2],
+    ) -> Result<Polished, String> {
+        let root = locate_root(branch, z, PARAMETER, test)?;
+        at[free] = root.fine.point[PARAMETER];
+        Ok(Polished {
+            at,
+            error: root.error,
+            z: root.fine.point,
+            free,
+            test: root.fine.test,
+            normal,
+        })
+    }
+
+    /// The point of the curve on the line through `at` (free in `free`)
+    /// from the continuum solutions `near` on the curve nearby: their
+    /// weighted mean as the start, each one's test (a wall's both, if they
+    /// differ).
+    fn near_neighbours(
+        &self,
+        at: [f64; 2],
+        free: usize,
+        near: &[(&Polished, f64)],
+    ) -> Result<Polished, String> {
+        let branch = self.line(at, free, BOUNDARY_TOLERANCE)?;
+        let mut z = near.iter().map(|(p, w)| *w * p.z).sum::<BranchPoint>();
+        z[PARAMETER] = at[free];
+        let mut tests: Vec<TestFunction> = Vec::new();
+        // a wall's extrema are sought afresh on the solution at the start:
+        // the neighbours' may be other extrema
+        if matches!(near[0].0.test, TestFunction::Wall { .. }) {
+            let tests = wall_tests_on(&branch, z)?;
+            return self.first_root(&branch, at, free, z, tests, near[0].0.normal, self.spacing);
+        }
+        // a singular test keeps its neighbour's borders: the singular
+        // vectors at a continuum root nearby
+        for (p, _) in near {
+            let t = p.test.clone();
+            let same = tests.iter().any(|u| match (u, &t) {
+                (TestFunction::Wall { wall: a, .. }, TestFunction::Wall { wall: b, .. }) => a == b,
+                _ => true,
+            });
+            if !same {
+                tests.push(t);
+            }
+        }
+        self.first_root(&branch, at, free, z, tests, near[0].0.normal, self.spacing)
+    }
+
+    /// The point of the curve a fraction `w` of the way from `a` to `b`, two
+    /// polished neighbours on it.
+    fn between(&self, a: &Polished, b: &Polished, w: f64) -> Result<Polished, String> {
+        let at = [
+            a.at[0] + w * (b.at[0] - a.at[0]),
+            a.at[1] + w * (b.at[1] - a.at[1]),
+        ];
+        self.near_neighbours(at, a.free, &[(a, 1.0 - w), (b, w)])
+    }
+
+    /// Each gap of the pieces split into `parts(a, b)` equal parts, the
+    /// points between polished in parallel.
+    fn subdivide(
+        &self,
+        pieces: &[Vec<Polished>],
+        parts: impl Fn(&Polished, &Polished) -> usize + Sync,
+    ) -> Result<Vec<Vec<Polished>>, String> {
+        let jobs: Vec<(usize, usize, f64)> = pieces
+            .iter()
+            .enumerate()
+            .flat_map(|(k, p)| {
+                let parts = &parts;
+                (1..p.len()).flat_map(move |i| {
+                    let m = parts(&p[i - 1], &p[i]).max(1);
+                    (1..m).map(move |j| (k, i, j as f64 / m as f64))
+                })
+            })
+            .collect();
+        let inserted: Vec<Polished> = jobs
+            .par_iter()
+            .map(|&(k, i, w)| self.between(&pieces[k][i - 1], &pieces[k][i], w))
+            .collect::<Result<_, _>>()?;
+        let mut inserted = jobs.iter().zip(inserted).peekable();
+        Ok(pieces
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                let mut v = vec![p[0].clone()];
+                for (i, q) in p.iter().enumerate().skip(1) {
+                    while let Some(((_, _, _), r)) =
+                        inserted.next_if(|((kk, ii, _), _)| *kk == k && *ii == i)
+                    {
+                        v.push(r);
+                    }
+                    v.push(q.clone());
+                }
+                v
+            })
+            .collect())
+    }
+
+    /// The corner where the test `test_b` vanishes along the curve of
+    /// `test_a` (both taken from polished points nearby, so that a singular
+    /// test's borders are those at a continuum root), from the walk's
+    /// corner `p` (whose normal is `a`'s): the
+    /// secant method on the coordinate held on `a`'s lines, each step
+    /// `a`'s root on its line and `b`'s test there; then again at a
+    /// hundredth of the tolerance.
+    fn corner(
+        &self,
+        p: &TrailPoint,
+        test_a: TestFunction,
+        test_b: TestFunction,
+    ) -> Result<Polished, String> {
+        let state = p.state.as_ref().ok_or("no discrete equilibrium")?;
+        let free = free_of(p.normal);
+        let (at, z) = self.start(state, free);
+        let coarse = self.secant_corner(at, free, z, test_a, test_b, BOUNDARY_TOLERANCE, 1e-4)?;
+        let fine = self.secant_corner(
+            coarse.0.at,
+            free,
+            coarse.0.z,
+            coarse.0.test.clone(),
+            coarse.1.clone(),
+            BOUNDARY_TOLERANCE * 1e-2,
+            (10.0 * coarse.2).max(1e-8),
+        )?;
+        let mut corner = fine.0;
+        corner.error = (0..2)
+            .map(|k| (corner.at[k] - coarse.0.at[k]).abs())
+            .fold(fine.2 + corner.error, f64::max);
+        corner.normal = p.normal;
+        Ok(corner)
+    }
+
+    /// Secant iteration for a corner: the root of `test_b` along the curve of
+    /// `test_a`, from `at` with first step `step` in the held coordinate;
+    /// the corner, `test_b` updated, and the last step.
+    #[allow(clippy::too_many_arguments)]
+    fn secant_corner(
+        &self,
+        at: [f64; 2],
+        free: usize,
+        z: BranchPoint,
+        test_a: TestFunction,
+        test_b: TestFunction,
+        tolerance: f64,
+        step: f64,
+    ) -> Result<(Polished, TestFunction, f64), String> {
+        let held = 1 - free;
+        // a's root on the line with the held coordinate at `v`, and b there
+        let on_a = |v: f64, z: BranchPoint, ta: &TestFunction, tb: &TestFunction| {
+            let mut q = at;
+            q[held] = v;
+            let branch = self.line(q, free, tolerance)?;
+            let scale = 1.0 + z[PARAMETER].abs();
+            let located = branch
+                .locate(
+                    z,
+                    PARAMETER,
+                    1e-4 * scale,
+                    0.1 * tolerance * scale,
+                    ta.clone(),
+                )
+                .map_err(|e| e.to_string())?;
+            let (tb, gb) = branch
+                .evaluate(&located.point, tb)
+                .map_err(|e| e.to_string())?;
+            q[free] = located.point[PARAMETER];
+            let error = (located.point[PARAMETER] - located.previous[PARAMETER]).abs();
+            Ok::<_, String>((
+                Polished {
+                    at: q,
+                    error,
+                    z: located.point,
+                    free,
+                    test: located.test,
+                    normal: [0.0, 0.0],
+                },
+                tb,
+                gb,
+            ))
+        };
+        let (mut pa, mut tb, mut ga) = on_a(at[held], z, &test_a, &test_b)?;
+        let (mut pb, t, mut gb) = on_a(at[held] + step, pa.z, &pa.test.clone(), &tb)?;
+        tb = t;
+        for _ in 0..40 {
+            if gb == ga || !gb.is_finite() {
+                break;
+            }
+            let dv = -gb * (pb.at[held] - pa.at[held]) / (gb - ga);
+            if dv.abs() > 0.05 {
+                return Err(format!("the corner's secant step {dv:.2e} left the corner"));
+            }
+            // predict the unknowns along the chord of the last two points
+            let f = dv / (pb.at[held] - pa.at[held]);
+            let zc = pb.z + f * (pb.z - pa.z);
+            let (pc, t, gc) = on_a(pb.at[held] + dv, zc, &pb.test.clone(), &tb)?;
+            tb = t;
+            (pa, ga) = (pb, gb);
+            (pb, gb) = (pc, gc);
+            if dv.abs() < tolerance * (1.0 + pb.at[held].abs()) {
+                return Ok((pb, tb, dv.abs()));
+            }
+        }
+        Err("the corner's secant steps did not converge".into())
+    }
+}
+
+/// The wall tests of the continuum solution near z: for each wall the
+/// interior point of the centreline nearest it (of 200), corrected onto the
+/// line first.
+fn wall_tests_on(branch: &ContinuumBranch, z: BranchPoint) -> Result<Vec<TestFunction>, String> {
+    const SAMPLES: usize = 200;
+    let z = branch.correct(z, PARAMETER).map_err(|e| e.to_string())?;
+    let stops: Vec<f64> = (1..SAMPLES).map(|k| k as f64 / SAMPLES as f64).collect();
+    let frames = branch.frames_at(&z, &stops).map_err(|e| e.to_string())?;
+    let clamps = branch.clamps_at(z[PARAMETER]);
+    let (origin, axis) = (clamps.start_point(), clamps.start_tangent());
+    let heights: Vec<f64> = frames.iter().map(|f| (f.r - origin).dot(&axis)).collect();
+    // local minima of the height for the bottom wall, maxima for the top
+    let h = &heights;
+    let extremal =
+        |i: usize, sign: f64| sign * (h[i] - h[i - 1]) <= 0.0 && sign * (h[i] - h[i + 1]) <= 0.0;
+    Ok([(0.0, 1.0), (clamps.top_wall(), -1.0)]
+        .into_iter()
+        .filter_map(|(wall, sign)| {
+            (1..h.len() - 1)
+                .filter(|&i| extremal(i, sign))
+                .min_by(|&i, &j| (h[i] - wall).abs().total_cmp(&(h[j] - wall).abs()))
+                .map(|i| TestFunction::Wall { wall, s: stops[i] })
+        })
+        .collect())
+}
+
+/// Shoelace area of a closed polygon.
+fn shoelace(points: &[[f64; 2]]) -> f64 {
+    let n = points.len();
+    0.5 * (0..n)
+        .map(|k| {
+            let (a, b) = (points[k], points[(k + 1) % n]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum::<f64>()
+        .abs()
+}
+
+/// Every `stride`-th point of a piece, keeping its ends.
+fn thinned(points: &[[f64; 2]], stride: usize) -> Vec<[f64; 2]> {
+    let last = points.len() - 1;
+    let mut v: Vec<[f64; 2]> = points.iter().step_by(stride).copied().collect();
+    if !last.is_multiple_of(stride) {
+        v.push(points[last]);
+    }
+    v
+}
+
+/// Polish a closed walk's `trail` (pieces with their discrete equilibria)
+/// on the continuum of `model`, in the plane of `params` (swept, along),
+/// its points no farther apart than `spacing` (the walk's largest step).
+pub(super) fn polish_boundary(
+    model: &RodModel,
+    params: [Parameter; 2],
+    base: Clamps,
+    trail: &[Trail],
+    spacing: f64,
+) -> Result<PolishedBoundary, String> {
+    let plane = Plane {
+        model,
+        params,
+        base,
+        spacing,
+    };
+    if trail.is_empty() {
+        return Err("no boundary to polish".into());
+    }
+    let last = trail.len() - 1;
+    // the points other than corners (where one piece ends and the next
+    // starts), each on its line from its discrete equilibrium
+    let jobs: Vec<(usize, usize)> = trail
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (_, pts))| {
+            let first = usize::from(k > 0);
+            let end = if k < last { pts.len() - 1 } else { pts.len() };
+            (first..end).map(move |i| (k, i))
+        })
+        .collect();
+    let describe = |k: usize, i: usize, e: String| {
+        let (c, pts) = &trail[k];
+        format!(
+            "{} at ({:.5}, {:.5}): {e}",
+            c.describe(),
+            pts[i].at[0],
+            pts[i].at[1]
+        )
+    };
+    let first: Vec<Result<Polished, String>> = jobs
+        .par_iter()
+        .map(|&(k, i)| plane.point(&trail[k].1[i], &trail[k].0))
+        .collect();
+    let retried = first;
+    // a point that fails (its discrete start too far from the continuum,
+    // next to a branch point say) is left out, and said so: its
+    // neighbours' middle is polished instead
+    let mut dropped = Vec::new();
+    let (jobs, points): (Vec<(usize, usize)>, Vec<Polished>) = jobs
+        .into_iter()
+        .zip(retried)
+        .filter_map(|((k, i), r)| match r {
+            Ok(p) => Some(((k, i), p)),
+            Err(e) => {
+                dropped.push(describe(k, i, e));
+                None
+            }
+        })
+        .unzip();
+    if dropped.len() * 10 > jobs.len() {
+        return Err(format!(
+            "{} of {} points failed, the first: {}",
+            dropped.len(),
+            jobs.len() + dropped.len(),
+            dropped[0]
+        ));
+    }
+    // the corners, with the tests of their pieces' polished points nearest
+    let corners: Vec<Polished> = (1..trail.len())
+        .into_par_iter()
+        .map(|k| {
+            let (a, pa) = &trail[k - 1];
+            let (b, _) = &trail[k];
+            let corner = pa.last().expect("pieces have points");
+            let state = corner.state.as_ref().ok_or("no discrete equilibrium")?;
+            let test = |piece: usize, from_end: bool| -> Result<TestFunction, String> {
+                let mut mine = jobs.iter().zip(&points).filter(|(j, _)| j.0 == piece);
+                let nearest = if from_end {
+                    mine.next_back()
+                } else {
+                    mine.next()
+                };
+                match nearest {
+                    Some((_, p)) => Ok(p.test.clone()),
+                    None => {
+                        let free = free_of(corner.normal);
+                        let (at, z) = plane.start(state, free);
+                        let branch = plane.line(at, free, BOUNDARY_TOLERANCE)?;
+                        let c = &trail[piece].0;
+                        Ok(plane.tests_of(&branch, &z, state, c)?.remove(0))
+                    }
+                }
+            };
+            let (test_a, test_b) = (test(k - 1, true)?, test(k, false)?);
+            // along a's curve; else along b's (from b's side of the corner)
+            plane
+                .corner(corner, test_a.clone(), test_b.clone())
+                .or_else(|first| {
+                    let from_b = &trail[k].1[0];
+                    plane
+                        .corner(from_b, test_b, test_a)
+                        .map_err(|second| format!("{first}; along the other curve: {second}"))
+                })
+                .map_err(|e| format!("corner of {} and {}: {e}", a.describe(), b.describe()))
+        })
+        .collect::<Result<_, _>>()?;
+    let largest_shift = jobs
+        .iter()
+        .zip(&points)
+        .map(|(&(k, i), p)| (trail[k].1[i].at[p.free] - p.at[p.free]).abs())
+        .fold(0.0, f64::max);
+    // the pieces on the continuum: corners at their ends, points in between
+    // (a point the polish moved past a corner dropped)
+    let mut pieces: Vec<Vec<Polished>> = Vec::new();
+    for (k, (_, pts)) in trail.iter().enumerate() {
+        let mut piece = Vec::new();
+        if k > 0 {
+            piece.push(corners[k - 1].clone());
+        }
+        piece.extend(
+            jobs.iter()
+                .zip(&points)
+                .filter(|(j, _)| j.0 == k)
+                .map(|(_, p)| p.clone()),
+        );
+        if k + 1 < trail.len() {
+            piece.push(corners[k].clone());
+        }
+        trim_past_corners(&mut piece, pts, k > 0, k + 1 < trail.len());
+        pieces.push(piece);
+    }
+    // gaps wider than the walk's step (where the polish moved a corner
+    // past the discrete piece's end) filled, then a point between each pair
+    // of neighbours
+    let length = |a: &Polished, b: &Polished| (b.at[0] - a.at[0]).hypot(b.at[1] - a.at[1]);
+    let filled = plane
+        .subdivide(&pieces, |a, b| (length(a, b) / spacing).ceil() as usize)
+        .map_err(|e| format!("filling the pieces: {e}"))?;
+    let refined = plane
+        .subdivide(&filled, |_, _| 2)
+        .map_err(|e| format!("between two points: {e}"))?;
+    // areas of nested polygons: all points (h), the walk's (2h), every other
+    // walk point (4h)
+    let polygon = |stride: usize| -> Vec<[f64; 2]> {
+        refined
+            .iter()
+            .flat_map(|p| {
+                let at: Vec<[f64; 2]> = p.iter().map(|q| q.at).collect();
+                let mut t = thinned(&at, stride);
+                t.pop();
+                t
+            })
+            .collect()
+    };
+    let (a1, a2, a4) = (
+        shoelace(&polygon(1)),
+        shoelace(&polygon(2)),
+        shoelace(&polygon(4)),
+    );
+    let (r1, r2) = (a1 + (a1 - a2) / 3.0, a2 + (a2 - a4) / 3.0);
+    let all: Vec<&Polished> = refined.iter().flatten().collect();
+    let largest_point_error = all.iter().map(|p| p.error).fold(0.0, f64::max);
+    let perimeter: f64 = polygon(1)
+        .iter()
+        .zip(polygon(1).iter().cycle().skip(1))
+        .map(|(a, b)| (b[0] - a[0]).hypot(b[1] - a[1]))
+        .sum();
+    let area_error = (r1 - r2).abs() + largest_point_error * perimeter;
+    // named as the discrete walk's pieces
+    let trail_polished: Vec<Trail> = trail
+        .iter()
+        .zip(&refined)
+        .map(|((c, _), p)| {
+            let pts = p
+                .iter()
+                .map(|q| TrailPoint {
+                    at: q.at,
+                    normal: q.normal,
+                    state: None,
+                })
+                .collect();
+            (*c, pts)
+        })
+        .collect();
+    let named = name_pieces(params, 0, trail_polished, true, None);
+    let label_ending = |at: [f64; 2]| {
+        named
+            .pieces
+            .iter()
+            .find(|p| p.points.last() == Some(&at))
+            .map_or(String::new(), |p| p.label.clone())
+    };
+    let label_starting = |at: [f64; 2]| {
+        named
+            .pieces
+            .iter()
+            .find(|p| p.points.first() == Some(&at))
+            .map_or(String::new(), |p| p.label.clone())
+    };
+    let corners = corners
+        .iter()
+        .enumerate()
+        .map(|(k, c)| PolishedCorner {
+            between: [label_ending(c.at), label_starting(c.at)],
+            point: c.at,
+            error: c.error,
+            discrete: trail[k].1.last().expect("pieces have points").at,
+        })
+        .collect();
+    Ok(PolishedBoundary {
+        pieces: named.pieces,
+        corners,
+        area: r1,
+        area_error,
+        area_polygon: a1,
+        largest_point_error,
+        largest_shift,
+        tolerance: BOUNDARY_TOLERANCE,
+        dropped,
+    })
+}
+
+/// Drop the interior points of a polished piece that the polish moved past
+/// one of its corners (along the discrete piece's direction there).
+fn trim_past_corners(piece: &mut Vec<Polished>, discrete: &[TrailPoint], start: bool, end: bool) {
+    let direction = |a: [f64; 2], b: [f64; 2]| [b[0] - a[0], b[1] - a[1]];
+    let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+    let n = discrete.len();
+    if n < 2 {
+        return;
+    }
+    if start {
+        let t = direction(discrete[0].at, discrete[1].at);
+        let c = piece[0].at;
+        while piece.len() > 2 && dot(direction(c, piece[1].at), t) <= 0.0 {
+            piece.remove(1);
+        }
+    }
+    if end {
+        let t = direction(discrete[n - 2].at, discrete[n - 1].at);
+        let c = piece[piece.len() - 1].at;
+        while piece.len() > 2 && dot(direction(piece[piece.len() - 2].at, c), t) <= 0.0 {
+            piece.remove(piece.len() - 2);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nested_polygons_of_a_circle_extrapolate_to_its_area() {
+        // a quarter circle as one piece (ends kept), closed through the origin
+        let arc = |n: usize| -> Vec<[f64; 2]> {
+            (0..=n)
+                .map(|k| {
+                    let t = std::f64::consts::FRAC_PI_2 * k as f64 / n as f64;
+                    [t.cos(), t.sin()]
+                })
+                .collect()
+        };
+        let fine = arc(16);
+        let closed = |p: Vec<[f64; 2]>| {
+            let mut v = p;
+            v.push([0.0, 0.0]);
+            v
+        };
+        let a1 = shoelace(&closed(thinned(&fine, 1)));
+        let a2 = shoelace(&closed(thinned(&fine, 2)));
+        let exact = std::f64::consts::FRAC_PI_4;
+        let richardson = a1 + (a1 - a2) / 3.0;
+        assert!((exact - a1).abs() > 1e-3);
+        assert!((exact - richardson).abs() < 1e-5, "{richardson}");
+        // every other point keeps the piece's ends
+        assert_eq!(thinned(&arc(5), 2).len(), 4);
+        assert_eq!(*thinned(&arc(5), 2).last().unwrap(), arc(5)[5]);
+    }
+}
