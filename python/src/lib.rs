@@ -76,21 +76,6 @@ impl PyScene {
         Ok(PyScene { scene, text })
     }
 
-    /// Parse a scene given as JSON text (a dict's `json.dumps`): it is
-    /// written as TOML and read by the same parser as a file, so errors name
-    /// the field the same way.
-    #[staticmethod]
-    fn from_json(json: &str) -> PyResult<Self> {
-        let value: toml::Value = serde_json::from_str(json)
-            .map_err(|e| SceneError::new_err(format!("scene: not a table of sections: {e}")))?;
-        let text = toml::to_string(&value).map_err(|e| {
-            SceneError::new_err(format!(
-                "scene: cannot be written as TOML ({e}); use numbers, strings, booleans, lists and dicts"
-            ))
-        })?;
-        Self::from_text(text)
-    }
-
     /// The scene as JSON text (every section, defaults filled in).
     fn to_json(&self) -> PyResult<String> {
         serde_json::to_string(&self.scene).map_err(|e| KnotrodError::new_err(e.to_string()))
@@ -142,6 +127,11 @@ fn parse_field(message: &str, text: Option<&str>) -> Option<String> {
     let (Some(text), Some(line)) = (text, line) else {
         return quoted;
     };
+    // the scene's own required sections: the parser points at the first
+    // table, which is not where they are missing from
+    if message.contains("missing field `model`") || message.contains("missing field `clamps`") {
+        return quoted;
+    }
     let lines: Vec<&str> = text.lines().collect();
     let here = lines.get(line.checked_sub(1)?)?.trim();
     let table = lines[..line.min(lines.len())]
@@ -151,6 +141,10 @@ fn parse_field(message: &str, text: Option<&str>) -> Option<String> {
         .find(|l| l.starts_with('[') && l.ends_with(']'))
         .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim().to_string());
     let key = if here.starts_with('[') {
+        // an unknown table is its own field
+        if quoted.as_deref() == table.as_deref() {
+            return quoted;
+        }
         quoted
     } else {
         here.split('=')
