@@ -540,18 +540,18 @@ fn knot_type<'py>(
     Ok(d)
 }
 
-/// Read a recording (MCAP): (scalars, events, metadata, states), the states
-/// as dicts of arrays with the recorded scalars.
-#[pyfunction]
-fn read_recording<'py>(
-    py: Python<'py>,
-    path: PathBuf,
-) -> PyResult<(
+/// A recording as Python values: (scalars, events, metadata, states).
+type RecordingParts<'py> = (
     Bound<'py, PyAny>,
     Bound<'py, PyAny>,
     Bound<'py, PyAny>,
     Bound<'py, PyList>,
-)> {
+);
+
+/// Read a recording (MCAP): (scalars, events, metadata, states), the states
+/// as dicts of arrays with the recorded scalars.
+#[pyfunction]
+fn read_recording<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RecordingParts<'py>> {
     let bytes = std::fs::read(&path).map_err(|e| {
         pyo3::exceptions::PyOSError::new_err(format!("cannot read {}: {e}", path.display()))
     })?;
