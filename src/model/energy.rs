@@ -1112,6 +1112,68 @@ impl RodEnergy {
         }
     }
 
+    /// Internal force and moment n(s), m(s) at the centre of every edge
+    /// j = 0..=N (s = jh), in that edge's material frame (d1, d2, d3): what
+    /// the rod beyond the cut exerts on the part before it. As for
+    /// [`Self::clamp_reactions`], minus the derivative of the elastic energy
+    /// with respect to a rigid translation and rotation, about the edge's
+    /// centre, of the part before the cut (nodes 0..=j+1, angles 0..=j) — or,
+    /// in the rod's second half, plus that of the part after it (nodes
+    /// j..=N+1, angles j..=N), so both clamps are cut like the s = 0 one and
+    /// edge N gives the reaction at s = 1. Edge 0 of a paper clamp is the
+    /// clamp reaction (exactly, for a weightless rod). The weight is a load
+    /// along the rod, not an internal force, so its share of the gradient is
+    /// left out; a constrained law's multipliers are not included (as in the
+    /// clamp reactions).
+    pub fn internal_loads(&self, state: &RodState) -> Vec<ClampReactions> {
+        let g = self.full_gradient(state);
+        let n = self.model.segments;
+        let weight = if self.terms.gravity {
+            self.gravity_gradient(&self.model_at(state))
+        } else {
+            Vector3::zeros()
+        };
+        let elastic = |i: usize| {
+            if (1..=n).contains(&i) {
+                g.nodes[i] - weight
+            } else {
+                g.nodes[i]
+            }
+        };
+        let angle = |j: usize| g.theta[j] * state.directors(j)[2];
+        // running sums (Σ g_i, Σ x_i × g_i + Σ g_θk t_k) of the part moved;
+        // about the point p the moment is the second minus p × the first
+        let node = |i: usize| (elastic(i), state.nodes[i].cross(&elastic(i)));
+        let half = n / 2;
+        let mut sums = vec![(Vector3::zeros(), Vector3::zeros()); n + 1];
+        let mut acc = node(0);
+        for (j, sum) in sums.iter_mut().enumerate().take(half + 1) {
+            let (f, m) = node(j + 1);
+            acc = (acc.0 + f, acc.1 + m + angle(j));
+            // the part before pushes back: minus its derivative
+            *sum = (-acc.0, -acc.1);
+        }
+        let mut acc = node(n + 1);
+        for j in (half + 1..=n).rev() {
+            let (f, m) = node(j);
+            acc = (acc.0 + f, acc.1 + m + angle(j));
+            sums[j] = acc;
+        }
+        sums.iter()
+            .enumerate()
+            .map(|(j, (force, about_origin))| {
+                let p = 0.5 * (state.nodes[j] + state.nodes[j + 1]);
+                let moment = about_origin - p.cross(force);
+                let [d1, d2, d3] = state.directors(j);
+                let frame = |v: &Vector3<f64>| Vector3::new(v.dot(&d1), v.dot(&d2), v.dot(&d3));
+                ClampReactions {
+                    force: frame(force),
+                    moment: frame(&moment),
+                }
+            })
+            .collect()
+    }
+
     /// Lumped mass of each free dof: the segment length for node coordinates,
     /// zero for material angles (no rotational inertia, as in the paper) and
     /// for a free end's ghost node beyond s ∈ [0, 1].

@@ -1,0 +1,591 @@
+//! `knotrod._knotrod`: the Rust half of the Python package `knotrod`.
+//!
+//! It does no physics: each function parses a scene, calls one library entry
+//! point with the GIL released, and turns the result into Python objects
+//! (plain dicts, lists and numpy arrays); the pure-Python package
+//! (python/knotrod/) wraps those in documented classes. Every library error
+//! becomes a `SceneError` or `SolveError`, a panic a `SolveError` (caught
+//! here, never unwound into the interpreter), and Ctrl-C during a run a
+//! `KeyboardInterrupt` carrying what was computed.
+
+use knotrod::analysis::equilibrium::Equilibrium;
+use knotrod::analysis::event::Event;
+use knotrod::analysis::profile::Profile;
+use knotrod::geometry::closure::{extent, ray_closure};
+use knotrod::io::recording::{Recorder, parse_recording, parse_state};
+use knotrod::io::verify_file::read_solutions;
+use knotrod::model::rod::{Parameter, RodModel};
+use knotrod::scene::{Job, Scene, SceneError as LibSceneError};
+use knotrod::study::error::StudyError;
+use knotrod::study::map::{Line, LineStore};
+use knotrod::study::verify::{SolutionCheck, VerifyOptions, verify_all};
+use knotrod::{knot_type as lib_knot_type, writhe_closed};
+use nalgebra::Vector3;
+use numpy::{PyArray1, PyArray2, PyArray3};
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::PathBuf;
+
+pyo3::create_exception!(
+    _knotrod,
+    KnotrodError,
+    PyException,
+    "Base class of knotrod's errors."
+);
+pyo3::create_exception!(
+    _knotrod,
+    SceneError,
+    KnotrodError,
+    "A scene that cannot be used; `field` names the offending field (dotted, e.g. `model.segments`) when known."
+);
+pyo3::create_exception!(
+    _knotrod,
+    SolveError,
+    KnotrodError,
+    "A solve or study that failed; `reason` says why, `last` is the last equilibrium computed (a dict) or None."
+);
+
+/// The message said when a run is stopped by Ctrl-C (the observer's error).
+const INTERRUPTED: &str = "interrupted (Ctrl-C): stopped after this equilibrium";
+
+/// A validated scene and the TOML text it came from (kept for recordings).
+#[pyclass(name = "Scene", module = "knotrod._knotrod", frozen)]
+struct PyScene {
+    /// The scene.
+    scene: Scene,
+    /// Its TOML text.
+    text: String,
+}
+
+#[pymethods]
+impl PyScene {
+    /// Read and validate a scene file (`Scene::load`).
+    #[staticmethod]
+    fn from_toml(path: PathBuf) -> PyResult<Self> {
+        let scene = Scene::load(&path).map_err(|e| scene_error(&e, None))?;
+        let text = std::fs::read_to_string(&path).unwrap_or_default();
+        Ok(PyScene { scene, text })
+    }
+
+    /// Parse and validate scene text (TOML).
+    #[staticmethod]
+    fn from_text(text: String) -> PyResult<Self> {
+        let scene = Scene::parse(&text).map_err(|e| scene_error(&e, Some(&text)))?;
+        Ok(PyScene { scene, text })
+    }
+
+    /// The scene as JSON text (every section, defaults filled in).
+    fn to_json(&self) -> PyResult<String> {
+        serde_json::to_string(&self.scene).map_err(|e| KnotrodError::new_err(e.to_string()))
+    }
+
+    /// The scene's TOML text.
+    #[getter]
+    fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// The scene's N (model.segments).
+    #[getter]
+    fn segments(&self) -> i64 {
+        self.scene.model.segments
+    }
+}
+
+/// A `SceneError` from the library's, with `field` set: the dotted field of
+/// an invalid value, or (for a parse error of `text`) the key on the line
+/// the parser points at, under its table.
+fn scene_error(e: &LibSceneError, text: Option<&str>) -> PyErr {
+    let field = match e {
+        LibSceneError::Invalid { field, .. } => Some(field.to_string()),
+        LibSceneError::TooLarge { key, .. } => Some(key.to_string()),
+        LibSceneError::Parse { message, .. } => parse_field(message, text),
+        LibSceneError::Io { .. } => None,
+    };
+    let err = SceneError::new_err(e.to_string());
+    Python::attach(|py| {
+        let _ = err.value(py).setattr("field", field);
+    });
+    err
+}
+
+/// The field a TOML parse error is about: `missing field `x``, `unknown
+/// field `x`` or the key of the line ("line L, column C: …"), prefixed with
+/// the table the line is in.
+fn parse_field(message: &str, text: Option<&str>) -> Option<String> {
+    let quoted = message
+        .split('`')
+        .nth(1)
+        .filter(|_| message.contains("field `"))
+        .map(str::to_string);
+    let line: Option<usize> = message
+        .strip_prefix("line ")
+        .and_then(|r| r.split(',').next())
+        .and_then(|n| n.trim().parse().ok());
+    let (Some(text), Some(line)) = (text, line) else {
+        return quoted;
+    };
+    // the scene's own required sections: the parser points at the first
+    // table, which is not where they are missing from
+    if message.contains("missing field `model`") || message.contains("missing field `clamps`") {
+        return quoted;
+    }
+    let lines: Vec<&str> = text.lines().collect();
+    let here = lines.get(line.checked_sub(1)?)?.trim();
+    let table = lines[..line.min(lines.len())]
+        .iter()
+        .rev()
+        .map(|l| l.trim())
+        .find(|l| l.starts_with('[') && l.ends_with(']'))
+        .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim().to_string());
+    let key = if here.starts_with('[') {
+        // an unknown table is its own field
+        if quoted.as_deref() == table.as_deref() {
+            return quoted;
+        }
+        quoted
+    } else {
+        here.split('=')
+            .next()
+            .map(|k| k.trim().trim_matches('"').to_string())
+            .filter(|k| !k.is_empty())
+            .or(quoted)
+    };
+    match (table, key) {
+        (Some(t), Some(k)) => Some(format!("{t}.{k}")),
+        (None, k) => k,
+        (t, None) => t,
+    }
+}
+
+/// A `SolveError` with the reason (the error and its chain of steps) and
+/// the last equilibrium computed; a scene error inside a study stays a
+/// `SceneError`.
+fn study_error(
+    py: Python<'_>,
+    e: &StudyError,
+    last: Option<&Equilibrium>,
+    model: &RodModel,
+) -> PyErr {
+    let mut inner = e;
+    while let StudyError::At { source, .. } = inner {
+        inner = source;
+    }
+    if let StudyError::Scene(se) = inner {
+        return scene_error(se, None);
+    }
+    let mut reason = e.to_string();
+    let mut source = std::error::Error::source(e);
+    while let Some(s) = source {
+        reason.push_str(": ");
+        reason.push_str(&s.to_string());
+        source = s.source();
+    }
+    let err = SolveError::new_err(reason.clone());
+    let value = err.value(py);
+    let _ = value.setattr("reason", reason);
+    let last = last.and_then(|eq| equilibrium_dict(py, eq, model).ok());
+    let _ = value.setattr("last", last);
+    err
+}
+
+/// Run `f` with the GIL released, a panic turned into a `SolveError`.
+fn detached<T: Send>(py: Python<'_>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    py.detach(|| catch_unwind(AssertUnwindSafe(f)))
+        .map_err(|p| {
+            let what = p
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown".into());
+            SolveError::new_err(format!("internal error (a bug in knotrod): {what}"))
+        })
+}
+
+/// Check `segments` as the CLI does.
+fn check_segments(segments: Option<usize>) -> PyResult<()> {
+    match segments {
+        Some(n) if !(4..=1_000_000).contains(&n) => Err(PyValueError::new_err(format!(
+            "segments must be in 4..=1000000, got {n}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Python objects from serde (through the json module: plain dicts, lists,
+/// floats, ints, strings, None).
+fn to_py<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(value).map_err(|e| KnotrodError::new_err(e.to_string()))?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// An (n, 3) array.
+fn rows<'py>(py: Python<'py>, v: &[[f64; 3]]) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let rows: Vec<Vec<f64>> = v.iter().map(|r| r.to_vec()).collect();
+    Ok(PyArray2::from_vec2(py, &rows)?)
+}
+
+/// The arrays of a state along s (nodes, directors, strains, n(s), m(s) and
+/// their arc lengths) into `d`.
+fn add_arrays(
+    py: Python<'_>,
+    d: &Bound<'_, PyDict>,
+    model: &RodModel,
+    state: &knotrod::RodState,
+) -> PyResult<()> {
+    let p = Profile::of(model, state);
+    let nodes: Vec<[f64; 3]> = state.nodes.iter().map(|x| [x[0], x[1], x[2]]).collect();
+    d.set_item("nodes", rows(py, &nodes)?)?;
+    d.set_item("theta", PyArray1::from_slice(py, &state.theta))?;
+    let directors: Vec<Vec<Vec<f64>>> = p
+        .directors
+        .iter()
+        .map(|f| f.iter().map(|v| v.to_vec()).collect())
+        .collect();
+    d.set_item("directors", PyArray3::from_vec3(py, &directors)?)?;
+    d.set_item("strains", rows(py, &p.strains)?)?;
+    d.set_item("force", rows(py, &p.force)?)?;
+    d.set_item("moment", rows(py, &p.moment)?)?;
+    d.set_item("s_nodes", PyArray1::from_slice(py, &p.s_nodes))?;
+    d.set_item("s_edges", PyArray1::from_slice(py, &p.s_edges))?;
+    d.set_item("s_vertices", PyArray1::from_slice(py, &p.s_vertices))?;
+    d.set_item(
+        "state_json",
+        serde_json::to_string(state).unwrap_or_default(),
+    )?;
+    Ok(())
+}
+
+/// An equilibrium as a dict: its scalars (the JSON summary's fields) and
+/// the arrays of its state.
+fn equilibrium_dict<'py>(
+    py: Python<'py>,
+    eq: &Equilibrium,
+    model: &RodModel,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut value = serde_json::to_value(eq).map_err(|e| KnotrodError::new_err(e.to_string()))?;
+    if let Some(o) = value.as_object_mut() {
+        o.remove("state");
+    }
+    let d = to_py(py, &value)?.cast_into::<PyDict>()?;
+    add_arrays(py, &d, model, &eq.state)?;
+    Ok(d)
+}
+
+/// Solve a scene's equilibrium (its start, solved and measured).
+#[pyfunction]
+#[pyo3(signature = (scene, segments=None, allow_large=false))]
+fn solve<'py>(
+    py: Python<'py>,
+    scene: &PyScene,
+    segments: Option<usize>,
+    allow_large: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    check_segments(segments)?;
+    let s = &scene.scene;
+    s.check_budget(Job::Run, segments, allow_large)
+        .map_err(|e| scene_error(&e, None))?;
+    let model = s.rod_model(segments);
+    match detached(py, || knotrod::solve_scene(s, segments))? {
+        Ok(eq) => equilibrium_dict(py, &eq, &model),
+        Err(e) => Err(study_error(py, &e, None, &model)),
+    }
+}
+
+/// What `run` hands back: equilibria, events, and the error that stopped it.
+struct RunOutcome {
+    /// The equilibria, in order.
+    equilibria: Vec<Equilibrium>,
+    /// The labelled events (empty when the run stopped early).
+    events: Vec<Event>,
+    /// Why it stopped early.
+    error: Option<StudyError>,
+    /// The Python exception raised in the observer (Ctrl-C, or the
+    /// progress callback's own).
+    python: Option<PyErr>,
+}
+
+/// Run a scene (a branch, a sweep of branches or a loading path): every
+/// equilibrium is kept, handed to `progress` (a dict of its scalars) and
+/// recorded (MCAP) when `record` names a file. Returns (equilibria, events);
+/// Ctrl-C stops it after the current equilibrium with a KeyboardInterrupt
+/// whose `partial` is (equilibria, events) and the recording finalised.
+#[pyfunction]
+#[pyo3(signature = (scene, segments=None, progress=None, record=None, allow_large=false))]
+fn run<'py>(
+    py: Python<'py>,
+    scene: &PyScene,
+    segments: Option<usize>,
+    progress: Option<Py<PyAny>>,
+    record: Option<PathBuf>,
+    allow_large: bool,
+) -> PyResult<(Bound<'py, PyList>, Bound<'py, PyList>)> {
+    check_segments(segments)?;
+    let s = &scene.scene;
+    s.check_budget(Job::Run, segments, allow_large)
+        .map_err(|e| scene_error(&e, None))?;
+    let model = s.rod_model(segments);
+    let mut recorder = match &record {
+        Some(file) => Some(
+            Recorder::create(file, &scene.text, &model, s.model.rod_diameter)
+                .map_err(|e| KnotrodError::new_err(e.to_string()))?,
+        ),
+        None => None,
+    };
+    let outcome = detached(py, || {
+        let mut out = RunOutcome {
+            equilibria: Vec::new(),
+            events: Vec::new(),
+            error: None,
+            python: None,
+        };
+        let mut record_error = None;
+        let result = knotrod::run_scene(s, segments, &mut |eq: Equilibrium| {
+            if let Some(r) = recorder.as_mut()
+                && let Err(e) = r.record(&eq)
+            {
+                record_error = Some(e.to_string());
+            }
+            // the GIL for a moment: run Python's signal handlers (Ctrl-C
+            // raises KeyboardInterrupt here) and the progress callback
+            let python = Python::attach(|py| -> PyResult<()> {
+                py.check_signals()?;
+                if let Some(cb) = &progress {
+                    let d = PyDict::new(py);
+                    d.set_item("index", out.equilibria.len())?;
+                    d.set_item("branch", eq.branch)?;
+                    d.set_item("z_star", eq.z_star)?;
+                    d.set_item("delta", eq.delta)?;
+                    d.set_item("phi_over_2pi", eq.phi_over_2pi)?;
+                    d.set_item("twist", eq.twist)?;
+                    d.set_item("stable", eq.stable)?;
+                    d.set_item("good_knot", eq.good_knot)?;
+                    cb.call1(py, (d,))?;
+                }
+                Ok(())
+            });
+            out.equilibria.push(eq);
+            if let Some(e) = record_error.take() {
+                return Err(StudyError::Observer(format!("recording: {e}").into()));
+            }
+            if let Err(e) = python {
+                out.python = Some(e);
+                return Err(StudyError::Observer(INTERRUPTED.into()));
+            }
+            Ok(())
+        });
+        match result {
+            Ok(events) => out.events = events,
+            Err(e) => out.error = Some(e),
+        }
+        out
+    })?;
+    // the recording is finalised whatever happened, with what was computed
+    let finished = match recorder {
+        Some(mut r) => r
+            .events(&outcome.events)
+            .and_then(|()| r.finish())
+            .map_err(|e| KnotrodError::new_err(e.to_string())),
+        None => Ok(()),
+    };
+    let eqs = PyList::empty(py);
+    for eq in &outcome.equilibria {
+        eqs.append(equilibrium_dict(py, eq, &model)?)?;
+    }
+    let events = to_py(py, &outcome.events)?.cast_into::<PyList>()?;
+    if let Some(err) = outcome.python {
+        let value = err.value(py);
+        let _ = value.setattr("partial", (eqs.clone(), events.clone()));
+        let _ = value.setattr("recording", record.clone());
+        return Err(err);
+    }
+    if let Some(e) = &outcome.error {
+        return Err(study_error(py, e, outcome.equilibria.last(), &model));
+    }
+    finished?;
+    Ok((eqs, events))
+}
+
+/// Lines kept in memory only: a map from Python does not resume.
+struct NoStore;
+
+impl LineStore for NoStore {
+    fn get(&self, _index: usize, _value: f64) -> Option<Line> {
+        None
+    }
+    fn put(&self, _line: &Line) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+        Ok(())
+    }
+}
+
+/// Map a scene's good-knot region (its `[map]` and `[continuation]`): the
+/// assembled map as a dict (lines, intervals, grid, area), without the
+/// boundary walk.
+#[pyfunction]
+#[pyo3(signature = (scene, segments=None, allow_large=false))]
+fn map_scene<'py>(
+    py: Python<'py>,
+    scene: &PyScene,
+    segments: Option<usize>,
+    allow_large: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    check_segments(segments)?;
+    let s = &scene.scene;
+    s.check_budget(Job::Map, segments, allow_large)
+        .map_err(|e| scene_error(&e, None))?;
+    let (Some(spec), Some(cont)) = (s.map.clone(), s.continuation.clone()) else {
+        let err = SceneError::new_err("the scene needs [map] and [continuation] sections");
+        err.value(py).setattr("field", "map")?;
+        return Err(err);
+    };
+    let name = s.file_stem("map");
+    let indices: Vec<usize> = (0..spec.lines).collect();
+    let model = s.rod_model(segments);
+    let lines = detached(py, || {
+        knotrod::study::map::compute_lines(s, &spec, &indices, segments, &NoStore, &|_| {})
+    })?
+    .map_err(|e| study_error(py, &e, None, &model))?;
+    let map = knotrod::study::map::assemble(&name, &spec, cont.parameter, cont.range, lines, None);
+    to_py(py, &map)
+}
+
+/// Verify shooting solutions (a TOML, JSON or CSV file as `knotrod verify`
+/// reads) by the continuum and the discrete rod at N, 2N, 4N: one dict per
+/// solution.
+#[pyfunction]
+#[pyo3(signature = (path, scene=None, segments=(100, 200, 400), stiffness=1e7, fit=None))]
+fn verify<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    scene: Option<PathBuf>,
+    segments: (usize, usize, usize),
+    stiffness: f64,
+    fit: Option<&str>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (n1, n2, n3) = segments;
+    if !(n1 >= 4 && n2 == 2 * n1 && n3 == 2 * n2 && n3 <= 100_000) {
+        return Err(PyValueError::new_err(format!(
+            "segments: give N, 2N, 4N with 4 ≤ N and 4N ≤ 100000 (got {n1}, {n2}, {n3})"
+        )));
+    }
+    if !(stiffness.is_finite() && stiffness >= 1e3) {
+        return Err(PyValueError::new_err(format!(
+            "stiffness: a finite stretching stiffness of at least 1e3 (got {stiffness})"
+        )));
+    }
+    let fit = match fit {
+        Some(name) => Some(Parameter::named(name).ok_or_else(|| {
+            PyValueError::new_err(format!("fit: {name} is not a scene parameter"))
+        })?),
+        None => None,
+    };
+    let options = VerifyOptions {
+        segments: [n1, n2, n3],
+        fit,
+        stretching_stiffness: stiffness,
+        ..VerifyOptions::default()
+    };
+    let (base, solutions) = read_solutions(&path, scene.as_deref()).map_err(|e| {
+        let err = SceneError::new_err(e.to_string());
+        Python::attach(|py| {
+            let _ = err.value(py).setattr("field", None::<String>);
+        });
+        err
+    })?;
+    let model = base.rod_model(None);
+    let checks: Vec<SolutionCheck> =
+        detached(py, || verify_all(&base, &solutions, &options, &|_| {}))?
+            .map_err(|e| study_error(py, &e, None, &model))?;
+    to_py(py, &checks)
+}
+
+/// Writhe and knot type of a curve ((n, 3) points): closed as given, or
+/// (closed=False) closed by rays along −z from the first point and +z from
+/// the last. A dict: writhe, knot_determinant, alexander, knot_name,
+/// knot_names, crossings.
+#[pyfunction]
+#[pyo3(signature = (points, closed=true))]
+fn knot_type<'py>(
+    py: Python<'py>,
+    points: Vec<[f64; 3]>,
+    closed: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    if points.len() < 3 || points.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(PyValueError::new_err(
+            "points: at least 3 finite points (an (n, 3) array)",
+        ));
+    }
+    let pts: Vec<Vector3<f64>> = points.iter().map(|p| Vector3::from(*p)).collect();
+    let (writhe, kt) = detached(py, || {
+        if closed {
+            (writhe_closed(&pts), lib_knot_type(&pts))
+        } else {
+            let size = extent(&pts).max(1e-300);
+            let (down, up) = (-Vector3::z(), Vector3::z());
+            // the writhe's closure error decays as 1/(ray length)
+            let w = writhe_closed(&ray_closure(&pts, down, up, 1e6 * size));
+            (w, lib_knot_type(&ray_closure(&pts, down, up, 4.0 * size)))
+        }
+    })?;
+    let kt = kt.map_err(|e| PyValueError::new_err(format!("no knot type: {e}")))?;
+    let d = PyDict::new(py);
+    d.set_item("writhe", writhe)?;
+    d.set_item("knot_determinant", kt.determinant)?;
+    d.set_item("alexander", kt.alexander.clone())?;
+    d.set_item("knot_name", kt.name.clone())?;
+    d.set_item("knot_names", kt.names.clone())?;
+    d.set_item("crossings", kt.crossings)?;
+    Ok(d)
+}
+
+/// A recording as Python values: (scalars, events, metadata, states).
+type RecordingParts<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyList>,
+);
+
+/// Read a recording (MCAP): (scalars, events, metadata, states), the states
+/// as dicts of arrays with the recorded scalars.
+#[pyfunction]
+fn read_recording<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RecordingParts<'py>> {
+    let bytes = std::fs::read(&path).map_err(|e| {
+        pyo3::exceptions::PyOSError::new_err(format!("cannot read {}: {e}", path.display()))
+    })?;
+    let io = |e: knotrod::io::error::IoError| KnotrodError::new_err(e.to_string());
+    let rec = detached(py, || parse_recording(&path, &bytes))?.map_err(io)?;
+    let states = PyList::empty(py);
+    for (k, scalars) in rec.scalars.iter().enumerate() {
+        let msg = detached(py, || parse_state(&path, &bytes, k as u64))?.map_err(io)?;
+        let d = to_py(py, scalars)?.cast_into::<PyDict>()?;
+        add_arrays(py, &d, &msg.model, &msg.state)?;
+        states.append(d)?;
+    }
+    Ok((
+        to_py(py, &rec.scalars)?,
+        to_py(py, &rec.events)?,
+        to_py(py, &rec.metadata)?,
+        states,
+    ))
+}
+
+/// The extension module.
+#[pymodule]
+fn _knotrod(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("KnotrodError", py.get_type::<KnotrodError>())?;
+    m.add("SceneError", py.get_type::<SceneError>())?;
+    m.add("SolveError", py.get_type::<SolveError>())?;
+    m.add("INTERRUPTED", INTERRUPTED)?;
+    m.add_class::<PyScene>()?;
+    m.add_function(wrap_pyfunction!(solve, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(map_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(verify, m)?)?;
+    m.add_function(wrap_pyfunction!(knot_type, m)?)?;
+    m.add_function(wrap_pyfunction!(read_recording, m)?)?;
+    Ok(())
+}
