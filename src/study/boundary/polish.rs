@@ -278,6 +278,7 @@ impl Plane<'_> {
         at: [f64; 2],
         free: usize,
         near: &[(&Polished, f64)],
+        reach: f64,
     ) -> Result<Polished, String> {
         let branch = self.line(at, free, BOUNDARY_TOLERANCE)?;
         let mut z = near.iter().map(|(p, w)| *w * p.z).sum::<BranchPoint>();
@@ -287,7 +288,7 @@ impl Plane<'_> {
         // the neighbours' may be other extrema
         if matches!(near[0].0.test, TestFunction::Wall { .. }) {
             let tests = wall_tests_on(&branch, z)?;
-            return self.first_root(&branch, at, free, z, tests, near[0].0.normal, self.spacing);
+            return self.first_root(&branch, at, free, z, tests, near[0].0.normal, reach);
         }
         // a singular test keeps its neighbour's borders: the singular
         // vectors at a continuum root nearby
@@ -301,7 +302,7 @@ impl Plane<'_> {
                 tests.push(t);
             }
         }
-        self.first_root(&branch, at, free, z, tests, near[0].0.normal, self.spacing)
+        self.first_root(&branch, at, free, z, tests, near[0].0.normal, reach)
     }
 
     /// The point of the curve a fraction `w` of the way from `a` to `b`, two
@@ -311,7 +312,14 @@ impl Plane<'_> {
             a.at[0] + w * (b.at[0] - a.at[0]),
             a.at[1] + w * (b.at[1] - a.at[1]),
         ];
-        self.near_neighbours(at, a.free, &[(a, 1.0 - w), (b, w)])
+        // from the nearer neighbour's solution: a mean of two can be far
+        // from any solution where the unknowns turn quickly
+        let near = if w <= 0.5 { (a, 1.0) } else { (b, 1.0) };
+        // the line across the chord
+        let free = usize::from((b.at[0] - a.at[0]).abs() >= (b.at[1] - a.at[1]).abs());
+        // a root may lie as far from the chord as the chord is long
+        let chord = (b.at[0] - a.at[0]).hypot(b.at[1] - a.at[1]);
+        self.near_neighbours(at, free, &[near], self.spacing.max(chord))
     }
 
     /// Each gap of the pieces split into `parts(a, b)` equal parts, the
@@ -334,7 +342,15 @@ impl Plane<'_> {
             .collect();
         let inserted: Vec<Polished> = jobs
             .par_iter()
-            .map(|&(k, i, w)| self.between(&pieces[k][i - 1], &pieces[k][i], w))
+            .map(|&(k, i, w)| {
+                let (a, b) = (&pieces[k][i - 1], &pieces[k][i]);
+                self.between(a, b, w).map_err(|e| {
+                    format!(
+                        "between ({:.5}, {:.5}) and ({:.5}, {:.5}): {e}",
+                        a.at[0], a.at[1], b.at[0], b.at[1]
+                    )
+                })
+            })
             .collect::<Result<_, _>>()?;
         let mut inserted = jobs.iter().zip(inserted).peekable();
         Ok(pieces
