@@ -28,6 +28,5 @@ mod traced;
 mod walk;
 
 pub use condition::{Condition, OtherStrand, Strands};
-pub use polish::{PolishedBoundary, PolishedCorner};
-pub use traced::{GridCheck, Piece, Traced};
+pub use traced::{GridCheck, Piece, PolishedBoundary, PolishedCorner, Traced};
 pub use walk::trace_island;

@@ -10,59 +10,15 @@
 use crate::model::continuum_branch::{BranchPoint, ContinuumBranch, PARAMETER, TestFunction};
 use crate::model::rod::{Clamps, Parameter, RodModel, RodState};
 use crate::study::boundary::condition::{Condition, OtherStrand};
-use crate::study::boundary::traced::{Piece, Trail, TrailPoint, name_pieces};
+use crate::study::boundary::traced::{
+    PolishedBoundary, PolishedCorner, Trail, TrailPoint, name_pieces,
+};
 use crate::study::polish::{discrete_unknowns, locate_root, singular_at};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 /// Integrator tolerance of the boundary's polish: its points to about
 /// 1e-8, far below what the area's 1e-4 relative error needs.
 pub const BOUNDARY_TOLERANCE: f64 = 1e-8;
-
-/// A corner of the polished boundary.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct PolishedCorner {
-    /// The pieces it joins, in walk order.
-    pub between: [String; 2],
-    /// (swept parameter, value along) on the continuum.
-    pub point: [f64; 2],
-    /// Error estimate of either coordinate (the change when the
-    /// integrator's tolerance falls a hundredfold, plus the last steps).
-    pub error: f64,
-    /// The discrete rod's corner (the walk's).
-    pub discrete: [f64; 2],
-}
-
-/// The traced boundary on the continuum.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct PolishedBoundary {
-    /// The pieces, named as the traced ones: the walk's points and one
-    /// between each pair of neighbours, polished.
-    pub pieces: Vec<Piece>,
-    /// The corners.
-    pub corners: Vec<PolishedCorner>,
-    /// Enclosed area, Richardson-extrapolated from the polygons of all the
-    /// points and of the walk's points alone.
-    pub area: f64,
-    /// Its error estimate: the extrapolation's change from the walk's
-    /// points and every other one of them, plus the points' own errors
-    /// along the perimeter.
-    pub area_error: f64,
-    /// The shoelace area of the polygon of all the points (no
-    /// extrapolation).
-    pub area_polygon: f64,
-    /// Largest error estimate of a point's polished coordinate.
-    pub largest_point_error: f64,
-    /// Largest |discrete − continuum| of a walk point along its line: the
-    /// discrete rod's error at its N.
-    pub largest_shift: f64,
-    /// Integrator tolerance of the polish (its errors from a second pass at
-    /// a hundredth of it).
-    pub tolerance: f64,
-    /// Walk points the polish could not locate (left out, their
-    /// neighbours' middle polished instead), and why.
-    pub dropped: Vec<String>,
-}
 
 /// A point of the boundary on the continuum.
 #[derive(Clone, Debug)]

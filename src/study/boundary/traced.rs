@@ -3,7 +3,6 @@
 
 use crate::model::rod::{Parameter, RodState};
 use crate::study::boundary::condition::Condition;
-use crate::study::boundary::polish::PolishedBoundary;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -34,6 +33,51 @@ pub struct Piece {
     /// Points (swept parameter, value along) in walk order (good region on
     /// the left).
     pub points: Vec<[f64; 2]>,
+}
+
+/// A corner of the polished boundary.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PolishedCorner {
+    /// The pieces it joins, in walk order.
+    pub between: [String; 2],
+    /// (swept parameter, value along) on the continuum.
+    pub point: [f64; 2],
+    /// Error estimate of either coordinate (the change when the
+    /// integrator's tolerance falls a hundredfold, plus the last steps).
+    pub error: f64,
+    /// The discrete rod's corner (the walk's).
+    pub discrete: [f64; 2],
+}
+
+/// The traced boundary on the continuum.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PolishedBoundary {
+    /// The pieces, named as the traced ones: the walk's points and one
+    /// between each pair of neighbours, polished.
+    pub pieces: Vec<Piece>,
+    /// The corners.
+    pub corners: Vec<PolishedCorner>,
+    /// Enclosed area, Richardson-extrapolated from the polygons of all the
+    /// points and of the walk's points alone.
+    pub area: f64,
+    /// Its error estimate: the extrapolation's change from the walk's
+    /// points and every other one of them, plus the points' own errors
+    /// along the perimeter.
+    pub area_error: f64,
+    /// The shoelace area of the polygon of all the points (no
+    /// extrapolation).
+    pub area_polygon: f64,
+    /// Largest error estimate of a point's polished coordinate.
+    pub largest_point_error: f64,
+    /// Largest |discrete − continuum| of a walk point along its line: the
+    /// discrete rod's error at its N.
+    pub largest_shift: f64,
+    /// Integrator tolerance of the polish (its errors from a second pass at
+    /// a hundredth of it).
+    pub tolerance: f64,
+    /// Walk points the polish could not locate (left out, their
+    /// neighbours' middle polished instead), and why.
+    pub dropped: Vec<String>,
 }
 
 /// How the traced boundary compares with the grid of one-parameter branches.
