@@ -74,13 +74,20 @@ pub enum TestFunction {
         right: Vector6<f64>,
     },
     /// An interior extremum of the height (along the s = 0 clamp's tangent)
-    /// reaches `wall`; the extremum is sought near arclength `s`.
+    /// reaches a wall; the extremum is sought near arclength `s`.
     Wall {
-        /// The wall's height.
-        wall: f64,
+        /// The top wall (height z*, moving with the clamps), else the
+        /// bottom one (height 0).
+        top: bool,
         /// Arclength of the extremum (updated as it moves).
         s: f64,
     },
+    /// The walls, both: the smaller of the lowest interior extremum's
+    /// height and the top wall minus the highest one's (the discrete
+    /// boundary walk's condition), the extremum sought afresh along the
+    /// whole centreline at every evaluation, so that whichever part of the
+    /// rod comes nearest a wall counts.
+    Walls,
     /// Two strands of the centreline pass through each other: the signed
     /// distance of their closest points, sought near arclengths `s`.
     Crossing {
@@ -277,15 +284,48 @@ impl<'a> ContinuumBranch<'a> {
                 let (_, j) = self.problem(z[PARAMETER])?.linearise(&p)?;
                 Ok((test.clone(), bordered_determinant(&j, left, right)?))
             }
-            TestFunction::Wall { wall, s } => {
+            TestFunction::Wall { top, s } => {
                 let (s, h) = self.extremum(z, *s)?;
-                Ok((TestFunction::Wall { wall: *wall, s }, h - wall))
+                // the top wall moves with z* along a branch in z*
+                let wall = if *top {
+                    self.clamps_at(z[PARAMETER]).top_wall()
+                } else {
+                    0.0
+                };
+                Ok((TestFunction::Wall { top: *top, s }, h - wall))
             }
+            TestFunction::Walls => Ok((TestFunction::Walls, self.wall_gap(z)?)),
             TestFunction::Crossing { s } => {
                 let (s, d) = self.closest_strands(z, *s)?;
                 Ok((TestFunction::Crossing { s }, d))
             }
         }
+    }
+
+    /// The smaller of the lowest interior extremum's height and the top
+    /// wall minus the highest one's: the centreline sampled at 200 points,
+    /// the local extremum nearest a wall refined by Newton.
+    fn wall_gap(&self, z: &BranchPoint) -> Result<f64, BranchError> {
+        const SAMPLES: usize = 200;
+        let stops: Vec<f64> = (1..SAMPLES).map(|k| k as f64 / SAMPLES as f64).collect();
+        let frames = self.frames_at(z, &stops)?;
+        let h: Vec<f64> = frames.iter().map(|f| self.height(z, &f.r)).collect();
+        let top = self.clamps_at(z[PARAMETER]).top_wall();
+        // local minima against the bottom wall, maxima against the top
+        let mut best: Option<(f64, usize, bool)> = None;
+        for i in 1..h.len() - 1 {
+            for (upper, gap) in [(false, h[i]), (true, top - h[i])] {
+                let sign = if upper { -1.0 } else { 1.0 };
+                let extremal = sign * (h[i] - h[i - 1]) <= 0.0 && sign * (h[i] - h[i + 1]) <= 0.0;
+                if extremal && best.is_none_or(|b| gap < b.0) {
+                    best = Some((gap, i, upper));
+                }
+            }
+        }
+        let (_, i, upper) =
+            best.ok_or_else(|| BranchError::NoRoot("no interior extremum of the height".into()))?;
+        let (_, height) = self.extremum(z, stops[i])?;
+        Ok(if upper { top - height } else { height })
     }
 
     /// The interior extremum of the height nearest arclength `s0`: Newton

@@ -121,16 +121,16 @@ fn test_function(
             let (origin, axis) = (state.clamps.start_point(), state.clamps.start_tangent());
             let top = state.clamps.top_wall();
             let n = state.segments();
-            let (mut best, mut wall, mut s) = (f64::INFINITY, 0.0, 0.5);
+            let (mut best, mut on_top, mut s) = (f64::INFINITY, false, 0.5);
             for i in 1..=n.min(points.len() - 2) {
                 let h = (points[i] - origin).dot(&axis);
-                for w in [0.0, top] {
+                for (w, t) in [(0.0, false), (top, true)] {
                     if (h - w).abs() < best {
-                        (best, wall, s) = ((h - w).abs(), w, arc[i]);
+                        (best, on_top, s) = ((h - w).abs(), t, arc[i]);
                     }
                 }
             }
-            Ok(TestFunction::Wall { wall, s })
+            Ok(TestFunction::Wall { top: on_top, s })
         }
         Class::Crossing => {
             let approach =
@@ -192,6 +192,7 @@ fn polish_one(
         .twist;
     let arclengths = match &fine.test {
         TestFunction::Wall { s, .. } => vec![*s],
+        TestFunction::Walls => vec![],
         TestFunction::Crossing { s } => s.to_vec(),
         TestFunction::Singular { .. } => vec![],
     };

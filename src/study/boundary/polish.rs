@@ -92,23 +92,7 @@ impl Plane<'_> {
         c: &Condition,
     ) -> Result<Vec<TestFunction>, String> {
         match c {
-            Condition::Wall => {
-                let (points, arc) = state.centreline();
-                let (origin, axis) = (state.clamps.start_point(), state.clamps.start_tangent());
-                let interior = 1..=state.segments().min(points.len() - 2);
-                Ok([0.0, state.clamps.top_wall()]
-                    .into_iter()
-                    .filter_map(|wall| {
-                        interior
-                            .clone()
-                            .min_by(|&i, &j| {
-                                let gap = |k: usize| ((points[k] - origin).dot(&axis) - wall).abs();
-                                gap(i).total_cmp(&gap(j))
-                            })
-                            .map(|i| TestFunction::Wall { wall, s: arc[i] })
-                    })
-                    .collect())
-            }
+            Condition::Wall => Ok(vec![TestFunction::Walls]),
             Condition::Stability => Ok(vec![singular_at(branch, z)?]),
             Condition::Crossing(s) => {
                 let OtherStrand::Segment(j) = s.other else {
@@ -183,25 +167,49 @@ impl Plane<'_> {
         normal: [f64; 2],
         reach: f64,
     ) -> Result<Polished, String> {
-        let mut why = String::from("no test function");
+        let mut why: Vec<String> = Vec::new();
         let roots: Vec<Polished> = tests
             .into_iter()
             .filter_map(|t| match self.root_on(branch, at, free, z, t, normal) {
-                Ok(r) if (r.at[free] - at[free]).abs() <= reach => Some(r),
+                Ok(r) if (r.at[free] - at[free]).abs() <= reach => {
+                    // a root where another part of the rod is already
+                    // through a wall is not on the boundary
+                    let line = self.line(r.at, free, branch.tolerance).ok()?;
+                    match walled(&line, &r.z, WALL_SLACK) {
+                        Ok(true) => Some(r),
+                        Ok(false) => {
+                            why.push(format!(
+                                "the root at ({:.5}, {:.5}) is not between the walls",
+                                r.at[0], r.at[1]
+                            ));
+                            None
+                        }
+                        Err(e) => {
+                            why.push(e);
+                            None
+                        }
+                    }
+                }
                 Ok(r) => {
-                    why = format!(
+                    why.push(format!(
                         "the root moved {:.2e} from its start, more than {reach:.2e}",
                         (r.at[free] - at[free]).abs()
-                    );
+                    ));
                     None
                 }
                 Err(e) => {
-                    why = e;
+                    why.push(e);
                     None
                 }
             })
             .collect();
-        first_from_good_side(roots).ok_or(why)
+        first_from_good_side(roots).ok_or_else(|| {
+            if why.is_empty() {
+                "no test function".into()
+            } else {
+                why.join("; ")
+            }
+        })
     }
 
     fn root_on(
@@ -239,25 +247,9 @@ impl Plane<'_> {
         let branch = self.line(at, free, BOUNDARY_TOLERANCE)?;
         let mut z = near.iter().map(|(p, w)| *w * p.z).sum::<BranchPoint>();
         z[PARAMETER] = at[free];
-        let mut tests: Vec<TestFunction> = Vec::new();
-        // a wall's extrema are sought afresh on the solution at the start:
-        // the neighbours' may be other extrema
-        if matches!(near[0].0.test, TestFunction::Wall { .. }) {
-            let tests = wall_tests_on(&branch, z)?;
-            return self.first_root(&branch, at, free, z, tests, near[0].0.normal, reach);
-        }
         // a singular test keeps its neighbour's borders: the singular
         // vectors at a continuum root nearby
-        for (p, _) in near {
-            let t = p.test.clone();
-            let same = tests.iter().any(|u| match (u, &t) {
-                (TestFunction::Wall { wall: a, .. }, TestFunction::Wall { wall: b, .. }) => a == b,
-                _ => true,
-            });
-            if !same {
-                tests.push(t);
-            }
-        }
+        let tests = vec![near[0].0.test.clone()];
         self.first_root(&branch, at, free, z, tests, near[0].0.normal, reach)
     }
 
@@ -270,12 +262,17 @@ impl Plane<'_> {
         ];
         // from the nearer neighbour's solution: a mean of two can be far
         // from any solution where the unknowns turn quickly
-        let near = if w <= 0.5 { (a, 1.0) } else { (b, 1.0) };
+        // (the other's test is tried too: a wall's may be the other wall)
+        let near = if w <= 0.5 {
+            [(a, 1.0), (b, 0.0)]
+        } else {
+            [(b, 1.0), (a, 0.0)]
+        };
         // the line across the chord
         let free = usize::from((b.at[0] - a.at[0]).abs() >= (b.at[1] - a.at[1]).abs());
         // a root may lie as far from the chord as the chord is long
         let chord = (b.at[0] - a.at[0]).hypot(b.at[1] - a.at[1]);
-        self.near_neighbours(at, free, &[near], self.spacing.max(chord))
+        self.near_neighbours(at, free, &near, self.spacing.max(chord))
     }
 
     /// Each gap of the pieces split into `parts(a, b)` equal parts, the
@@ -435,31 +432,24 @@ impl Plane<'_> {
     }
 }
 
-/// The wall tests of the continuum solution near z: for each wall the
-/// interior point of the centreline nearest it (of 200), corrected onto the
-/// line first.
-fn wall_tests_on(branch: &ContinuumBranch, z: BranchPoint) -> Result<Vec<TestFunction>, String> {
+/// The continuum solution at z lies between the walls (to `slack`, touching
+/// allowed): checked at 200 points of the centreline.
+fn walled(branch: &ContinuumBranch, z: &BranchPoint, slack: f64) -> Result<bool, String> {
     const SAMPLES: usize = 200;
-    let z = branch.correct(z, PARAMETER).map_err(|e| e.to_string())?;
     let stops: Vec<f64> = (1..SAMPLES).map(|k| k as f64 / SAMPLES as f64).collect();
-    let frames = branch.frames_at(&z, &stops).map_err(|e| e.to_string())?;
+    let frames = branch.frames_at(z, &stops).map_err(|e| e.to_string())?;
     let clamps = branch.clamps_at(z[PARAMETER]);
     let (origin, axis) = (clamps.start_point(), clamps.start_tangent());
-    let heights: Vec<f64> = frames.iter().map(|f| (f.r - origin).dot(&axis)).collect();
-    // local minima of the height for the bottom wall, maxima for the top
-    let h = &heights;
-    let extremal =
-        |i: usize, sign: f64| sign * (h[i] - h[i - 1]) <= 0.0 && sign * (h[i] - h[i + 1]) <= 0.0;
-    Ok([(0.0, 1.0), (clamps.top_wall(), -1.0)]
-        .into_iter()
-        .filter_map(|(wall, sign)| {
-            (1..h.len() - 1)
-                .filter(|&i| extremal(i, sign))
-                .min_by(|&i, &j| (h[i] - wall).abs().total_cmp(&(h[j] - wall).abs()))
-                .map(|i| TestFunction::Wall { wall, s: stops[i] })
-        })
-        .collect())
+    let top = clamps.top_wall();
+    Ok(frames.iter().all(|f| {
+        let h = (f.r - origin).dot(&axis);
+        h >= -slack && h <= top + slack
+    }))
 }
+
+/// How far outside the walls a boundary point's continuum solution may
+/// reach (its touch is located to about the integrator's tolerance).
+const WALL_SLACK: f64 = 1e-5;
 
 /// Shoelace area of a closed polygon.
 fn shoelace(points: &[[f64; 2]]) -> f64 {
@@ -559,7 +549,10 @@ pub(super) fn polish_boundary(
             let (b, _) = &trail[k];
             let corner = pa.last().expect("pieces have points");
             let state = corner.state.as_ref().ok_or("no discrete equilibrium")?;
-            let test = |piece: usize, from_end: bool| -> Result<TestFunction, String> {
+            // the tests of the pieces' nearest polished points (a singular
+            // test's borders at a continuum root); a wall's both walls
+            let tests = |piece: usize, from_end: bool| -> Result<Vec<TestFunction>, String> {
+                let c = &trail[piece].0;
                 let mut mine = jobs.iter().zip(&points).filter(|(j, _)| j.0 == piece);
                 let nearest = if from_end {
                     mine.next_back()
@@ -567,27 +560,54 @@ pub(super) fn polish_boundary(
                     mine.next()
                 };
                 match nearest {
-                    Some((_, p)) => Ok(p.test.clone()),
-                    None => {
+                    Some((_, p)) if *c != Condition::Wall => Ok(vec![p.test.clone()]),
+                    _ => {
                         let free = free_of(corner.normal);
                         let (at, z) = plane.start(state, free);
                         let branch = plane.line(at, free, BOUNDARY_TOLERANCE)?;
-                        let c = &trail[piece].0;
-                        Ok(plane.tests_of(&branch, &z, state, c)?.remove(0))
+                        plane.tests_of(&branch, &z, state, c)
                     }
                 }
             };
-            let (test_a, test_b) = (test(k - 1, true)?, test(k, false)?);
-            // along a's curve; else along b's (from b's side of the corner)
-            plane
-                .corner(corner, test_a.clone(), test_b.clone())
-                .or_else(|first| {
-                    let from_b = &trail[k].1[0];
-                    plane
-                        .corner(from_b, test_b, test_a)
-                        .map_err(|second| format!("{first}; along the other curve: {second}"))
-                })
-                .map_err(|e| format!("corner of {} and {}: {e}", a.describe(), b.describe()))
+            let (tests_a, tests_b) = (tests(k - 1, true)?, tests(k, false)?);
+            // every pairing, along a's curve, else along b's (from b's side
+            // of the corner); of the corners between the walls, the one
+            // nearest the discrete corner
+            let mut why = String::new();
+            let mut found: Vec<Polished> = Vec::new();
+            for ta in &tests_a {
+                for tb in &tests_b {
+                    let attempt = plane
+                        .corner(corner, ta.clone(), tb.clone())
+                        .or_else(|first| {
+                            plane
+                                .corner(&trail[k].1[0], tb.clone(), ta.clone())
+                                .map_err(|second| {
+                                    format!("{first}; along the other curve: {second}")
+                                })
+                        });
+                    let checked = attempt.and_then(|c| {
+                        let line = plane.line(c.at, c.free, BOUNDARY_TOLERANCE)?;
+                        if walled(&line, &c.z, WALL_SLACK)? {
+                            Ok(c)
+                        } else {
+                            Err(format!(
+                                "the corner at ({:.5}, {:.5}) is not between the walls",
+                                c.at[0], c.at[1]
+                            ))
+                        }
+                    });
+                    match checked {
+                        Ok(c) => found.push(c),
+                        Err(e) => why = e,
+                    }
+                }
+            }
+            let distance = |c: &Polished| (c.at[0] - corner.at[0]).hypot(c.at[1] - corner.at[1]);
+            found
+                .into_iter()
+                .min_by(|x, y| distance(x).total_cmp(&distance(y)))
+                .ok_or_else(|| format!("corner of {} and {}: {why}", a.describe(), b.describe()))
         })
         .collect::<Result<_, _>>()?;
     let largest_shift = jobs
@@ -625,8 +645,7 @@ pub(super) fn polish_boundary(
     let refined = plane
         .subdivide(&filled, |_, _| 2)
         .map_err(|e| format!("between two points: {e}"))?;
-    // areas of nested polygons: all points (h), the walk's (2h), every other
-    // walk point (4h)
+    // areas of nested polygons: all points (h), and without the middles (2h)
     let polygon = |stride: usize| -> Vec<[f64; 2]> {
         refined
             .iter()
@@ -638,12 +657,8 @@ pub(super) fn polish_boundary(
             })
             .collect()
     };
-    let (a1, a2, a4) = (
-        shoelace(&polygon(1)),
-        shoelace(&polygon(2)),
-        shoelace(&polygon(4)),
-    );
-    let (r1, r2) = (a1 + (a1 - a2) / 3.0, a2 + (a2 - a4) / 3.0);
+    let (a1, a2) = (shoelace(&polygon(1)), shoelace(&polygon(2)));
+    let r1 = a1 + (a1 - a2) / 3.0;
     let all: Vec<&Polished> = refined.iter().flatten().collect();
     let largest_point_error = all.iter().map(|p| p.error).fold(0.0, f64::max);
     let perimeter: f64 = polygon(1)
@@ -651,7 +666,9 @@ pub(super) fn polish_boundary(
         .zip(polygon(1).iter().cycle().skip(1))
         .map(|(a, b)| (b[0] - a[0]).hypot(b[1] - a[1]))
         .sum();
-    let area_error = (r1 - r2).abs() + largest_point_error * perimeter;
+    // the Richardson correction is the finest polygon's estimated error,
+    // which bounds the extrapolated area's (an order smaller)
+    let area_error = (r1 - a1).abs() + largest_point_error * perimeter;
     // named as the discrete walk's pieces
     let trail_polished: Vec<Trail> = trail
         .iter()

@@ -60,9 +60,9 @@ pub struct PolishedBoundary {
     /// Enclosed area, Richardson-extrapolated from the polygons of all the
     /// points and of the walk's points alone.
     pub area: f64,
-    /// Its error estimate: the extrapolation's change from the walk's
-    /// points and every other one of them, plus the points' own errors
-    /// along the perimeter.
+    /// Its error estimate: the Richardson correction (the finest polygon's
+    /// estimated error, which bounds the extrapolated area's), plus the
+    /// points' own errors along the perimeter.
     pub area_error: f64,
     /// The shoelace area of the polygon of all the points (no
     /// extrapolation).
