@@ -28,6 +28,7 @@ fn small_map_scene(dir: &Path) -> PathBuf {
             ("range = [0.04, 0.30]", "range = [0.12, 0.18]"),
             ("lines = 27", "lines = 4"),
             ("grid_columns = 91", "grid_columns = 11"),
+            ("polish = true", "polish = false"),
         ],
     )
 }
@@ -133,6 +134,7 @@ fn island_boundary_traced_directly_agrees_with_the_grid() {
             ("range = [0.04, 0.30]", "range = [0.05, 0.29]"),
             ("lines = 27", "lines = 13"),
             ("grid_columns = 91", "grid_columns = 11"),
+            ("polish = true", "polish = false"),
         ],
     );
     let json = dir.join("trace.json");
@@ -165,4 +167,74 @@ fn island_boundary_traced_directly_agrees_with_the_grid() {
             .unwrap()
             .is_empty()
     );
+}
+
+/// The island's boundary polished on the continuum: started from the
+/// discrete walks at N = 40 and N = 60, which differ by the discretisation,
+/// its area and corners agree within their stated errors, and its area lies
+/// well away from the discrete loop's (the rod's O(1/N²) error).
+#[test]
+fn polished_island_is_the_same_from_two_discretisations() {
+    let dir = temp_dir("polish-map");
+    let polished = |n: &str| {
+        let scene = fig7_variant(
+            &dir,
+            &format!("polish{n}.toml"),
+            &[
+                ("segments = 100", &format!("segments = {n}")),
+                ("lines = 27", "lines = 2"),
+                ("grid_columns = 91", "grid_columns = 11"),
+            ],
+        );
+        let json = dir.join(format!("polish{n}.json"));
+        knotrod_ok(&[
+            "map",
+            scene.to_str().unwrap(),
+            "--json",
+            json.to_str().unwrap(),
+        ]);
+        let map: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+        let traced = map["traced"].clone();
+        assert!(
+            traced["polished"].is_object(),
+            "N = {n}: {}",
+            traced["not_polished"]
+        );
+        traced
+    };
+    let (a, b) = (polished("100"), polished("140"));
+    let f = |t: &serde_json::Value, k: &str| t["polished"][k].as_f64().unwrap();
+    let (area_a, area_b) = (f(&a, "area"), f(&b, "area"));
+    let bar = f(&a, "area_error") + f(&b, "area_error");
+    assert!(
+        (area_a - area_b).abs() <= bar,
+        "polished areas {area_a} and {area_b} differ by more than {bar:.2e}"
+    );
+    assert!(bar < 1e-4 * area_a, "error bar {bar:.2e} of {area_a}");
+    // the discrete loops are several percent smaller at these N
+    let discrete = a["area"].as_f64().unwrap();
+    assert!((area_a - discrete).abs() > 100.0 * bar);
+    let corners = |t: &serde_json::Value| t["polished"]["corners"].as_array().unwrap().clone();
+    let (ca, cb) = (corners(&a), corners(&b));
+    assert_eq!(ca.len(), 3);
+    assert_eq!(ca.len(), cb.len());
+    for (x, y) in ca.iter().zip(&cb) {
+        assert_eq!(x["between"], y["between"]);
+        let bar = x["error"].as_f64().unwrap() + y["error"].as_f64().unwrap();
+        for k in 0..2 {
+            let (p, q) = (
+                x["point"][k].as_f64().unwrap(),
+                y["point"][k].as_f64().unwrap(),
+            );
+            // beside the bars, each corner's secant stops within its
+            // resolution, 1e-8 of the coordinate
+            let resolution = 2.0 * 1e-8 * (1.0 + p.abs());
+            assert!(
+                (p - q).abs() <= bar + resolution,
+                "corner {}: {p} against {q} (bars {bar:.1e})",
+                x["between"]
+            );
+        }
+    }
 }

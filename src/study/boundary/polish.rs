@@ -330,13 +330,14 @@ impl Plane<'_> {
     /// corner `p` (whose normal is `a`'s): the
     /// secant method on the coordinate held on `a`'s lines, each step
     /// `a`'s root on its line and `b`'s test there; then again at a
-    /// hundredth of the tolerance.
+    /// hundredth of the tolerance. The corner carries `a`'s test; `b`'s
+    /// (updated) comes beside it.
     fn corner(
         &self,
         p: &TrailPoint,
         test_a: TestFunction,
         test_b: TestFunction,
-    ) -> Result<Polished, String> {
+    ) -> Result<(Polished, TestFunction), String> {
         let state = p.state.as_ref().ok_or("no discrete equilibrium")?;
         let free = free_of(p.normal);
         let (at, z) = self.start(state, free);
@@ -355,7 +356,7 @@ impl Plane<'_> {
             .map(|k| (corner.at[k] - coarse.0.at[k]).abs())
             .fold(fine.2 + corner.error, f64::max);
         corner.normal = p.normal;
-        Ok(corner)
+        Ok((corner, fine.1))
     }
 
     /// Secant iteration for a corner: the root of `test_b` along the curve of
@@ -542,7 +543,7 @@ pub(super) fn polish_boundary(
         ));
     }
     // the corners, with the tests of their pieces' polished points nearest
-    let corners: Vec<Polished> = (1..trail.len())
+    let corners: Vec<(Polished, Polished)> = (1..trail.len())
         .into_par_iter()
         .map(|k| {
             let (a, pa) = &trail[k - 1];
@@ -574,26 +575,46 @@ pub(super) fn polish_boundary(
             // of the corner); of the corners between the walls, the one
             // nearest the discrete corner
             let mut why = String::new();
-            let mut found: Vec<Polished> = Vec::new();
+            // (each side of the corner keeps its own piece's test and normal)
+            let mut found: Vec<(Polished, Polished)> = Vec::new();
+            let from_b = &trail[k].1[0];
+            let with = |p: &Polished, test: TestFunction, normal: [f64; 2]| Polished {
+                test,
+                normal,
+                ..p.clone()
+            };
             for ta in &tests_a {
                 for tb in &tests_b {
-                    let attempt = plane
+                    // along both curves: two routes to one corner, whose
+                    // difference joins its error estimate
+                    let along_a = plane
                         .corner(corner, ta.clone(), tb.clone())
-                        .or_else(|first| {
-                            plane
-                                .corner(&trail[k].1[0], tb.clone(), ta.clone())
-                                .map_err(|second| {
-                                    format!("{first}; along the other curve: {second}")
-                                })
-                        });
-                    let checked = attempt.and_then(|c| {
-                        let line = plane.line(c.at, c.free, BOUNDARY_TOLERANCE)?;
-                        if walled(&line, &c.z, WALL_SLACK)? {
-                            Ok(c)
+                        .map(|(c, tb)| (c.clone(), with(&c, tb, from_b.normal)));
+                    let along_b = plane
+                        .corner(from_b, tb.clone(), ta.clone())
+                        .map(|(c, ta)| (with(&c, ta, corner.normal), c));
+                    let attempt = match (along_a, along_b) {
+                        (Ok((mut ca, mut cb)), Ok((other, _))) => {
+                            let apart = (0..2)
+                                .map(|k| (ca.at[k] - other.at[k]).abs())
+                                .fold(other.error, f64::max);
+                            ca.error = ca.error.max(apart);
+                            cb.error = ca.error;
+                            Ok((ca, cb))
+                        }
+                        (Ok(c), Err(_)) | (Err(_), Ok(c)) => Ok(c),
+                        (Err(first), Err(second)) => {
+                            Err(format!("{first}; along the other curve: {second}"))
+                        }
+                    };
+                    let checked = attempt.and_then(|(ca, cb)| {
+                        let line = plane.line(ca.at, ca.free, BOUNDARY_TOLERANCE)?;
+                        if walled(&line, &ca.z, WALL_SLACK)? {
+                            Ok((ca, cb))
                         } else {
                             Err(format!(
                                 "the corner at ({:.5}, {:.5}) is not between the walls",
-                                c.at[0], c.at[1]
+                                ca.at[0], ca.at[1]
                             ))
                         }
                     });
@@ -603,7 +624,9 @@ pub(super) fn polish_boundary(
                     }
                 }
             }
-            let distance = |c: &Polished| (c.at[0] - corner.at[0]).hypot(c.at[1] - corner.at[1]);
+            let distance = |c: &(Polished, Polished)| {
+                (c.0.at[0] - corner.at[0]).hypot(c.0.at[1] - corner.at[1])
+            };
             found
                 .into_iter()
                 .min_by(|x, y| distance(x).total_cmp(&distance(y)))
@@ -621,7 +644,7 @@ pub(super) fn polish_boundary(
     for (k, (_, pts)) in trail.iter().enumerate() {
         let mut piece = Vec::new();
         if k > 0 {
-            piece.push(corners[k - 1].clone());
+            piece.push(corners[k - 1].1.clone());
         }
         piece.extend(
             jobs.iter()
@@ -630,7 +653,7 @@ pub(super) fn polish_boundary(
                 .map(|(_, p)| p.clone()),
         );
         if k + 1 < trail.len() {
-            piece.push(corners[k].clone());
+            piece.push(corners[k].0.clone());
         }
         trim_past_corners(&mut piece, pts, k > 0, k + 1 < trail.len());
         pieces.push(piece);
@@ -661,14 +684,23 @@ pub(super) fn polish_boundary(
     let r1 = a1 + (a1 - a2) / 3.0;
     let all: Vec<&Polished> = refined.iter().flatten().collect();
     let largest_point_error = all.iter().map(|p| p.error).fold(0.0, f64::max);
-    let perimeter: f64 = polygon(1)
+    // each point's error moves the boundary across half of each chord
+    // beside it
+    let ring: Vec<&Polished> = refined
         .iter()
-        .zip(polygon(1).iter().cycle().skip(1))
-        .map(|(a, b)| (b[0] - a[0]).hypot(b[1] - a[1]))
+        .flat_map(|p| p[..p.len() - 1].iter())
+        .collect();
+    let n = ring.len();
+    let chord = |i: usize| {
+        let (a, b) = (ring[i].at, ring[(i + 1) % n].at);
+        (b[0] - a[0]).hypot(b[1] - a[1])
+    };
+    let points_error: f64 = (0..n)
+        .map(|i| ring[i].error * 0.5 * (chord((i + n - 1) % n) + chord(i)))
         .sum();
     // the Richardson correction is the finest polygon's estimated error,
     // which bounds the extrapolated area's (an order smaller)
-    let area_error = (r1 - a1).abs() + largest_point_error * perimeter;
+    let area_error = (r1 - a1).abs() + points_error;
     // named as the discrete walk's pieces
     let trail_polished: Vec<Trail> = trail
         .iter()
@@ -703,7 +735,7 @@ pub(super) fn polish_boundary(
     let corners = corners
         .iter()
         .enumerate()
-        .map(|(k, c)| PolishedCorner {
+        .map(|(k, (c, _))| PolishedCorner {
             between: [label_ending(c.at), label_starting(c.at)],
             point: c.at,
             error: c.error,

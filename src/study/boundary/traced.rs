@@ -61,8 +61,8 @@ pub struct PolishedBoundary {
     /// points and of the walk's points alone.
     pub area: f64,
     /// Its error estimate: the Richardson correction (the finest polygon's
-    /// estimated error, which bounds the extrapolated area's), plus the
-    /// points' own errors along the perimeter.
+    /// estimated error, which bounds the extrapolated area's), plus each
+    /// point's own error times the half chords beside it.
     pub area_error: f64,
     /// The shoelace area of the polygon of all the points (no
     /// extrapolation).
