@@ -2,10 +2,11 @@
 //! located again as the root of its condition's continuum test function on
 //! the line of the plane through it that crosses the curve most steeply
 //! (held swept parameter, free value along the lines, or the other way
-//! round), every corner as the root of the next condition's test along the
-//! previous condition's curve, and a point polished between each pair of
-//! neighbours, so that the area has an N-independent value and a
-//! Richardson error estimate from nested point sets.
+//! round); every corner as the root of the next condition's test along the
+//! previous condition's curve, by both curves; gaps filled and a point
+//! polished between each pair of neighbours, so that the area has an
+//! N-independent value and a Richardson error estimate from nested point
+//! sets. Every root is checked to lie between the walls and near its start.
 
 use crate::model::continuum_branch::{BranchPoint, ContinuumBranch, PARAMETER, TestFunction};
 use crate::model::rod::{Clamps, Parameter, RodModel, RodState};
