@@ -302,14 +302,21 @@ impl<'a> ContinuumBranch<'a> {
         }
     }
 
+    /// The height of the solution at z at 199 interior points of the
+    /// centreline (s = k/200): the arclengths and the heights.
+    pub fn heights(&self, z: &BranchPoint) -> Result<(Vec<f64>, Vec<f64>), BranchError> {
+        const SAMPLES: usize = 200;
+        let stops: Vec<f64> = (1..SAMPLES).map(|k| k as f64 / SAMPLES as f64).collect();
+        let frames = self.frames_at(z, &stops)?;
+        let h = frames.iter().map(|f| self.height(z, &f.r)).collect();
+        Ok((stops, h))
+    }
+
     /// The smaller of the lowest interior extremum's height and the top
     /// wall minus the highest one's: the centreline sampled at 200 points,
     /// the local extremum nearest a wall refined by Newton.
     fn wall_gap(&self, z: &BranchPoint) -> Result<f64, BranchError> {
-        const SAMPLES: usize = 200;
-        let stops: Vec<f64> = (1..SAMPLES).map(|k| k as f64 / SAMPLES as f64).collect();
-        let frames = self.frames_at(z, &stops)?;
-        let h: Vec<f64> = frames.iter().map(|f| self.height(z, &f.r)).collect();
+        let (stops, h) = self.heights(z)?;
         let top = self.clamps_at(z[PARAMETER]).top_wall();
         // local minima against the bottom wall, maxima against the top
         let mut best: Option<(f64, usize, bool)> = None;

@@ -55,15 +55,6 @@ fn free_of(normal: [f64; 2]) -> usize {
     usize::from(normal[1].abs() >= normal[0].abs())
 }
 
-/// Of several roots of a condition on one line, the boundary's: the first
-/// met coming from the good side (along −normal).
-fn first_from_good_side(roots: Vec<Polished>) -> Option<Polished> {
-    roots.into_iter().max_by(|a, b| {
-        let n = a.normal[a.free];
-        (n * a.at[a.free]).total_cmp(&(n * b.at[b.free]))
-    })
-}
-
 impl Plane<'_> {
     fn clamps(&self, at: [f64; 2]) -> Clamps {
         self.params[0].with(&self.params[1].with(&self.base, at[1]), at[0])
@@ -80,21 +71,20 @@ impl Plane<'_> {
             .map_err(|e| e.to_string())
     }
 
-    /// The continuum test functions of condition `c` at the discrete `state`
-    /// (z: its shooting unknowns on `branch`): for walls one per wall (the
-    /// interior extremum nearest each), since near a flip-symmetric knot
-    /// both are touched almost at once and the continuum may touch the
-    /// other first.
-    fn tests_of(
+    /// The continuum test function of condition `c` at the discrete `state`
+    /// (z: its shooting unknowns on `branch`). Walls are both walls at once:
+    /// near a flip-symmetric knot both are touched almost together, and the
+    /// continuum may touch either first.
+    fn test_of(
         &self,
         branch: &ContinuumBranch,
         z: &BranchPoint,
         state: &RodState,
         c: &Condition,
-    ) -> Result<Vec<TestFunction>, String> {
+    ) -> Result<TestFunction, String> {
         match c {
-            Condition::Wall => Ok(vec![TestFunction::Walls]),
-            Condition::Stability => Ok(vec![singular_at(branch, z)?]),
+            Condition::Wall => Ok(TestFunction::Walls),
+            Condition::Stability => singular_at(branch, z),
             Condition::Crossing(s) => {
                 let OtherStrand::Segment(j) = s.other else {
                     return Err("a crossing of a clamp's ray is not polished".into());
@@ -110,12 +100,12 @@ impl Plane<'_> {
                     &points[j],
                     &points[j + 1],
                 );
-                Ok(vec![TestFunction::Crossing {
+                Ok(TestFunction::Crossing {
                     s: [
                         arc[i] + ta * (arc[i + 1] - arc[i]),
                         arc[j] + tb * (arc[j + 1] - arc[j]),
                     ],
-                }])
+                })
             }
         }
     }
@@ -150,67 +140,39 @@ impl Plane<'_> {
         let state = p.state.as_ref().ok_or("no discrete equilibrium")?;
         let (at, z) = self.start(state, free);
         let branch = self.line(at, free, BOUNDARY_TOLERANCE)?;
-        let tests = self.tests_of(&branch, &z, state, c)?;
-        self.first_root(&branch, at, free, z, tests, p.normal, 2.0 * self.spacing)
+        let test = self.test_of(&branch, &z, state, c)?;
+        self.checked_root(&branch, at, free, z, test, p.normal, 2.0 * self.spacing)
     }
 
-    /// The boundary's root on a line among those of `tests`, each within
-    /// `reach` of the start in the free coordinate (a root farther away is
-    /// another extremum's or another branch's).
+    /// The root of `test` on a line, refused when it lies farther than
+    /// `reach` from the start in the free coordinate (another extremum's or
+    /// another branch's root) or where the rod is through a wall.
     #[allow(clippy::too_many_arguments)]
-    fn first_root(
+    fn checked_root(
         &self,
         branch: &ContinuumBranch,
         at: [f64; 2],
         free: usize,
         z: BranchPoint,
-        tests: Vec<TestFunction>,
+        test: TestFunction,
         normal: [f64; 2],
         reach: f64,
     ) -> Result<Polished, String> {
-        let mut why: Vec<String> = Vec::new();
-        let roots: Vec<Polished> = tests
-            .into_iter()
-            .filter_map(|t| match self.root_on(branch, at, free, z, t, normal) {
-                Ok(r) if (r.at[free] - at[free]).abs() <= reach => {
-                    // a root where another part of the rod is already
-                    // through a wall is not on the boundary
-                    let line = self.line(r.at, free, branch.tolerance).ok()?;
-                    match walled(&line, &r.z, WALL_SLACK) {
-                        Ok(true) => Some(r),
-                        Ok(false) => {
-                            why.push(format!(
-                                "the root at ({:.5}, {:.5}) is not between the walls",
-                                r.at[0], r.at[1]
-                            ));
-                            None
-                        }
-                        Err(e) => {
-                            why.push(e);
-                            None
-                        }
-                    }
-                }
-                Ok(r) => {
-                    why.push(format!(
-                        "the root moved {:.2e} from its start, more than {reach:.2e}",
-                        (r.at[free] - at[free]).abs()
-                    ));
-                    None
-                }
-                Err(e) => {
-                    why.push(e);
-                    None
-                }
-            })
-            .collect();
-        first_from_good_side(roots).ok_or_else(|| {
-            if why.is_empty() {
-                "no test function".into()
-            } else {
-                why.join("; ")
-            }
-        })
+        let r = self.root_on(branch, at, free, z, test, normal)?;
+        let moved = (r.at[free] - at[free]).abs();
+        if moved > reach {
+            return Err(format!(
+                "the root moved {moved:.2e} from its start, more than {reach:.2e}"
+            ));
+        }
+        let line = self.line(r.at, free, branch.tolerance)?;
+        if !walled(&line, &r.z, WALL_SLACK)? {
+            return Err(format!(
+                "the root at ({:.5}, {:.5}) is not between the walls",
+                r.at[0], r.at[1]
+            ));
+        }
+        Ok(r)
     }
 
     fn root_on(
@@ -236,8 +198,7 @@ impl Plane<'_> {
 
     /// The point of the curve on the line through `at` (free in `free`)
     /// from the continuum solutions `near` on the curve nearby: their
-    /// weighted mean as the start, each one's test (a wall's both, if they
-    /// differ).
+    /// weighted mean as the start, the first one's test.
     fn near_neighbours(
         &self,
         at: [f64; 2],
@@ -250,8 +211,8 @@ impl Plane<'_> {
         z[PARAMETER] = at[free];
         // a singular test keeps its neighbour's borders: the singular
         // vectors at a continuum root nearby
-        let tests = vec![near[0].0.test.clone()];
-        self.first_root(&branch, at, free, z, tests, near[0].0.normal, reach)
+        let test = near[0].0.test.clone();
+        self.checked_root(&branch, at, free, z, test, near[0].0.normal, reach)
     }
 
     /// The point of the curve a fraction `w` of the way from `a` to `b`, two
@@ -435,18 +396,11 @@ impl Plane<'_> {
 }
 
 /// The continuum solution at z lies between the walls (to `slack`, touching
-/// allowed): checked at 200 points of the centreline.
+/// allowed), at the points of [`ContinuumBranch::heights`].
 fn walled(branch: &ContinuumBranch, z: &BranchPoint, slack: f64) -> Result<bool, String> {
-    const SAMPLES: usize = 200;
-    let stops: Vec<f64> = (1..SAMPLES).map(|k| k as f64 / SAMPLES as f64).collect();
-    let frames = branch.frames_at(z, &stops).map_err(|e| e.to_string())?;
-    let clamps = branch.clamps_at(z[PARAMETER]);
-    let (origin, axis) = (clamps.start_point(), clamps.start_tangent());
-    let top = clamps.top_wall();
-    Ok(frames.iter().all(|f| {
-        let h = (f.r - origin).dot(&axis);
-        h >= -slack && h <= top + slack
-    }))
+    let (_, heights) = branch.heights(z).map_err(|e| e.to_string())?;
+    let top = branch.clamps_at(z[PARAMETER]).top_wall();
+    Ok(heights.iter().all(|&h| h >= -slack && h <= top + slack))
 }
 
 /// How far outside the walls a boundary point's continuum solution may
@@ -551,10 +505,9 @@ pub(super) fn polish_boundary(
             let (b, _) = &trail[k];
             let corner = pa.last().expect("pieces have points");
             let state = corner.state.as_ref().ok_or("no discrete equilibrium")?;
-            // the tests of the pieces' nearest polished points (a singular
-            // test's borders at a continuum root); a wall's both walls
-            let tests = |piece: usize, from_end: bool| -> Result<Vec<TestFunction>, String> {
-                let c = &trail[piece].0;
+            // the test of the piece's nearest polished point (a singular
+            // test's borders at a continuum root), else the discrete corner's
+            let test = |piece: usize, from_end: bool| -> Result<TestFunction, String> {
                 let mut mine = jobs.iter().zip(&points).filter(|(j, _)| j.0 == piece);
                 let nearest = if from_end {
                     mine.next_back()
@@ -562,76 +515,60 @@ pub(super) fn polish_boundary(
                     mine.next()
                 };
                 match nearest {
-                    Some((_, p)) if *c != Condition::Wall => Ok(vec![p.test.clone()]),
-                    _ => {
+                    Some((_, p)) => Ok(p.test.clone()),
+                    None => {
                         let free = free_of(corner.normal);
                         let (at, z) = plane.start(state, free);
                         let branch = plane.line(at, free, BOUNDARY_TOLERANCE)?;
-                        plane.tests_of(&branch, &z, state, c)
+                        plane.test_of(&branch, &z, state, &trail[piece].0)
                     }
                 }
             };
-            let (tests_a, tests_b) = (tests(k - 1, true)?, tests(k, false)?);
-            // every pairing, along a's curve, else along b's (from b's side
-            // of the corner); of the corners between the walls, the one
-            // nearest the discrete corner
-            let mut why = String::new();
-            // (each side of the corner keeps its own piece's test and normal)
-            let mut found: Vec<(Polished, Polished)> = Vec::new();
+            let (ta, tb) = (test(k - 1, true)?, test(k, false)?);
+            // each side of the corner keeps its own piece's test and normal
             let from_b = &trail[k].1[0];
             let with = |p: &Polished, test: TestFunction, normal: [f64; 2]| Polished {
                 test,
                 normal,
                 ..p.clone()
             };
-            for ta in &tests_a {
-                for tb in &tests_b {
-                    // along both curves: two routes to one corner, whose
-                    // difference joins its error estimate
-                    let along_a = plane
-                        .corner(corner, ta.clone(), tb.clone())
-                        .map(|(c, tb)| (c.clone(), with(&c, tb, from_b.normal)));
-                    let along_b = plane
-                        .corner(from_b, tb.clone(), ta.clone())
-                        .map(|(c, ta)| (with(&c, ta, corner.normal), c));
-                    let attempt = match (along_a, along_b) {
-                        (Ok((mut ca, mut cb)), Ok((other, _))) => {
-                            let apart = (0..2)
-                                .map(|k| (ca.at[k] - other.at[k]).abs())
-                                .fold(other.error, f64::max);
-                            ca.error = ca.error.max(apart);
-                            cb.error = ca.error;
-                            Ok((ca, cb))
-                        }
-                        (Ok(c), Err(_)) | (Err(_), Ok(c)) => Ok(c),
-                        (Err(first), Err(second)) => {
-                            Err(format!("{first}; along the other curve: {second}"))
-                        }
-                    };
-                    let checked = attempt.and_then(|(ca, cb)| {
-                        let line = plane.line(ca.at, ca.free, BOUNDARY_TOLERANCE)?;
-                        if walled(&line, &ca.z, WALL_SLACK)? {
-                            Ok((ca, cb))
-                        } else {
-                            Err(format!(
-                                "the corner at ({:.5}, {:.5}) is not between the walls",
-                                ca.at[0], ca.at[1]
-                            ))
-                        }
-                    });
-                    match checked {
-                        Ok(c) => found.push(c),
-                        Err(e) => why = e,
-                    }
+            // along both curves: two routes to one corner, whose difference
+            // joins its error estimate
+            let along_a = plane
+                .corner(corner, ta.clone(), tb.clone())
+                .map(|(c, tb)| (c.clone(), with(&c, tb, from_b.normal)));
+            let along_b = plane
+                .corner(from_b, tb, ta)
+                .map(|(c, ta)| (with(&c, ta, corner.normal), c));
+            let (ca, cb) = match (along_a, along_b) {
+                (Ok((mut ca, mut cb)), Ok((other, _))) => {
+                    let apart = (0..2)
+                        .map(|k| (ca.at[k] - other.at[k]).abs())
+                        .fold(other.error, f64::max);
+                    ca.error = ca.error.max(apart);
+                    cb.error = ca.error;
+                    (ca, cb)
                 }
-            }
-            let distance = |c: &(Polished, Polished)| {
-                (c.0.at[0] - corner.at[0]).hypot(c.0.at[1] - corner.at[1])
+                (Ok(c), Err(_)) | (Err(_), Ok(c)) => c,
+                (Err(first), Err(second)) => {
+                    return Err(format!(
+                        "corner of {} and {}: {first}; along the other curve: {second}",
+                        a.describe(),
+                        b.describe()
+                    ));
+                }
             };
-            found
-                .into_iter()
-                .min_by(|x, y| distance(x).total_cmp(&distance(y)))
-                .ok_or_else(|| format!("corner of {} and {}: {why}", a.describe(), b.describe()))
+            let line = plane.line(ca.at, ca.free, BOUNDARY_TOLERANCE)?;
+            if !walled(&line, &ca.z, WALL_SLACK)? {
+                return Err(format!(
+                    "corner of {} and {}: at ({:.5}, {:.5}) the rod is not between the walls",
+                    a.describe(),
+                    b.describe(),
+                    ca.at[0],
+                    ca.at[1]
+                ));
+            }
+            Ok((ca, cb))
         })
         .collect::<Result<_, _>>()?;
     let largest_shift = jobs
@@ -719,25 +656,19 @@ pub(super) fn polish_boundary(
         })
         .collect();
     let named = name_pieces(params, 0, trail_polished, true, None);
-    let label_ending = |at: [f64; 2]| {
+    // the named piece ending (end) or starting at a corner
+    let label_at = |at: [f64; 2], end: bool| {
         named
             .pieces
             .iter()
-            .find(|p| p.points.last() == Some(&at))
-            .map_or(String::new(), |p| p.label.clone())
-    };
-    let label_starting = |at: [f64; 2]| {
-        named
-            .pieces
-            .iter()
-            .find(|p| p.points.first() == Some(&at))
+            .find(|p| if end { p.points.last() } else { p.points.first() } == Some(&at))
             .map_or(String::new(), |p| p.label.clone())
     };
     let corners = corners
         .iter()
         .enumerate()
         .map(|(k, (c, _))| PolishedCorner {
-            between: [label_ending(c.at), label_starting(c.at)],
+            between: [label_at(c.at, true), label_at(c.at, false)],
             point: c.at,
             error: c.error,
             discrete: trail[k].1.last().expect("pieces have points").at,
