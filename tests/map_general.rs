@@ -10,7 +10,7 @@ use knotrod::study::map::{Map, branch_intervals_in};
 use serde_json::Value;
 
 mod common;
-use common::{knotrod_ok, run, temp_dir};
+use common::{map_json, run, temp_dir};
 
 /// A scene file's text with some settings replaced (each must be there).
 fn variant(file: &str, replace: &[(&str, &str)]) -> String {
@@ -49,14 +49,7 @@ fn map_of(name: &str, file: &str, replace: &[(&str, &str)]) -> Map {
     let dir = temp_dir(name);
     let scene = dir.join(format!("{name}.toml"));
     std::fs::write(&scene, variant(file, replace)).unwrap();
-    let json = dir.join(format!("{name}.json"));
-    knotrod_ok(&[
-        "map",
-        scene.to_str().unwrap(),
-        "--json",
-        json.to_str().unwrap(),
-    ]);
-    serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap()
+    map_json(&scene, &dir.join(format!("{name}.json")))
 }
 
 /// How often the traced boundary crosses the map's lines, each crossing

@@ -94,6 +94,16 @@ pub enum TestFunction {
         /// Arclengths of the two closest points (updated as they move).
         s: [f64; 2],
     },
+    /// The closest points of two strands near arclengths `s` merge with
+    /// another critical point of their distance (a pitchfork or fold of the
+    /// closest approach: where two crossings of the same strands run into
+    /// one, and a boundary's crossing piece ends on another): the
+    /// determinant of the closest-point conditions' Jacobian there, which
+    /// changes sign through the merger on the critical point that persists.
+    Merging {
+        /// Arclengths of the critical point (updated as it moves).
+        s: [f64; 2],
+    },
 }
 
 /// An event located on the continuum branch.
@@ -296,8 +306,12 @@ impl<'a> ContinuumBranch<'a> {
             }
             TestFunction::Walls => Ok((TestFunction::Walls, self.wall_gap(z)?)),
             TestFunction::Crossing { s } => {
-                let (s, d) = self.closest_strands(z, *s)?;
+                let (s, d, _) = self.closest_strands(z, *s)?;
                 Ok((TestFunction::Crossing { s }, d))
+            }
+            TestFunction::Merging { s } => {
+                let (s, _, det) = self.closest_strands(z, *s)?;
+                Ok((TestFunction::Merging { s }, det))
             }
         }
     }
@@ -370,15 +384,17 @@ impl<'a> ContinuumBranch<'a> {
     }
 
     /// The closest points of two strands near arclengths `s0` (Newton on
-    /// the two orthogonality conditions) and their signed distance, positive
-    /// along t_a × t_b.
+    /// the two orthogonality conditions), their signed distance, positive
+    /// along t_a × t_b, and the determinant of the conditions' Jacobian.
     fn closest_strands(
         &self,
         z: &BranchPoint,
         s0: [f64; 2],
-    ) -> Result<([f64; 2], f64), BranchError> {
+    ) -> Result<([f64; 2], f64, f64), BranchError> {
         let mut s = s0;
-        for _ in 0..30 {
+        // next to a merger of critical points Newton converges only
+        // linearly (by 2/3 a step at a pitchfork)
+        for _ in 0..100 {
             let (fa, ra) = self.frame_and_rate(z, s[0])?;
             let (fb, rb) = self.frame_and_rate(z, s[1])?;
             let d = fa.r - fb.r;
@@ -389,6 +405,7 @@ impl<'a> ContinuumBranch<'a> {
                 -fa.d3.dot(&fb.d3),
                 1.0 - d.dot(&rb),
             );
+            let det = jac.determinant();
             let Some(step) = jac.lu().solve(&(-g)) else {
                 break;
             };
@@ -403,7 +420,7 @@ impl<'a> ContinuumBranch<'a> {
                     break;
                 }
                 let signed = (f[0].r - f[1].r).dot(&normal) / normal.norm();
-                return Ok((s, signed));
+                return Ok((s, signed, det));
             }
         }
         Err(BranchError::NoRoot(format!(

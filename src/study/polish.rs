@@ -193,7 +193,7 @@ fn polish_one(
     let arclengths = match &fine.test {
         TestFunction::Wall { s, .. } => vec![*s],
         TestFunction::Walls => vec![],
-        TestFunction::Crossing { s } => s.to_vec(),
+        TestFunction::Crossing { s } | TestFunction::Merging { s } => s.to_vec(),
         TestFunction::Singular { .. } => vec![],
     };
     Ok(ContinuumEvent {

@@ -28,6 +28,20 @@ pub fn knotrod_ok(args: &[&str]) {
     );
 }
 
+/// Run `knotrod map scene --json json` and read the map back.
+pub fn map_json<T: serde::de::DeserializeOwned>(
+    scene: &std::path::Path,
+    json: &std::path::Path,
+) -> T {
+    knotrod_ok(&[
+        "map",
+        scene.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    serde_json::from_slice(&std::fs::read(json).unwrap()).unwrap()
+}
+
 /// A fresh directory `knotrod-{name}-{pid}` under the system's temporary
 /// directory (created).
 pub fn temp_dir(name: &str) -> PathBuf {

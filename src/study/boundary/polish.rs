@@ -303,6 +303,20 @@ impl Plane<'_> {
         let state = p.state.as_ref().ok_or("no discrete equilibrium")?;
         let free = free_of(p.normal);
         let (at, z) = self.start(state, free);
+        self.corner_from(at, z, free, p.normal, test_a, test_b)
+    }
+
+    /// [`Plane::corner`] from the point `at` (unknowns `z` on its line free
+    /// in `free`) of `a`'s curve, whose normal is `normal`.
+    fn corner_from(
+        &self,
+        at: [f64; 2],
+        z: BranchPoint,
+        free: usize,
+        normal: [f64; 2],
+        test_a: TestFunction,
+        test_b: TestFunction,
+    ) -> Result<(Polished, TestFunction), String> {
         let coarse = self.secant_corner(at, free, z, test_a, test_b, BOUNDARY_TOLERANCE, 1e-4)?;
         let fine = self.secant_corner(
             coarse.0.at,
@@ -317,8 +331,39 @@ impl Plane<'_> {
         corner.error = (0..2)
             .map(|k| (corner.at[k] - coarse.0.at[k]).abs())
             .fold(fine.2 + corner.error, f64::max);
-        corner.normal = p.normal;
+        corner.normal = normal;
         Ok((corner, fine.1))
+    }
+
+    /// Whether the crossings of `a` (its point nearest the corner) and `b`
+    /// (its nearest) run into one: `a`'s closest points, followed to `b`'s
+    /// solution, land on `b`'s (or the other way round). Then the test of
+    /// their merger on the critical point that persists.
+    fn merger(&self, a: &Polished, b: &Polished) -> Option<TestFunction> {
+        let (TestFunction::Crossing { s: sa }, TestFunction::Crossing { s: sb }) =
+            (&a.test, &b.test)
+        else {
+            return None;
+        };
+        let followed = |from: &TestFunction, to: &Polished| -> Option<[f64; 2]> {
+            let line = self.line(to.at, to.free, BOUNDARY_TOLERANCE).ok()?;
+            match line.evaluate(&to.z, from).ok()?.0 {
+                TestFunction::Crossing { s } => Some(s),
+                _ => None,
+            }
+        };
+        // landed: within a hundredth of the way between the two (the
+        // closest points are ill-determined along strands nearly parallel)
+        let lands = |s: Option<[f64; 2]>, on: &[f64; 2]| {
+            s.is_some_and(|s| apart(&s, on) < 1e-2 * apart(sa, sb))
+        };
+        if lands(followed(&a.test, b), sb) {
+            Some(TestFunction::Merging { s: *sb })
+        } else if lands(followed(&b.test, a), sa) {
+            Some(TestFunction::Merging { s: *sa })
+        } else {
+            None
+        }
     }
 
     /// Secant iteration for a corner: the root of `test_b` along the curve of
@@ -372,9 +417,13 @@ impl Plane<'_> {
         let (mut pa, mut tb, mut ga) = on_a(at[held], z, &test_a, &test_b)?;
         let (mut pb, t, mut gb) = on_a(at[held] + step, pa.z, &pa.test.clone(), &tb)?;
         tb = t;
-        for _ in 0..40 {
+        let mut visited = vec![pa.at[held], pb.at[held]];
+        let why = loop {
+            if visited.len() > 42 {
+                break "did not converge".to_string();
+            }
             if gb == ga || !gb.is_finite() {
-                break;
+                break format!("met a flat or undefined test ({gb:.2e})");
             }
             let dv = -gb * (pb.at[held] - pa.at[held]) / (gb - ga);
             if dv.abs() > 0.05 {
@@ -383,17 +432,35 @@ impl Plane<'_> {
             // predict the unknowns along the chord of the last two points
             let f = dv / (pb.at[held] - pa.at[held]);
             let zc = pb.z + f * (pb.z - pa.z);
-            let (pc, t, gc) = on_a(pb.at[held] + dv, zc, &pb.test.clone(), &tb)?;
+            let (pc, t, gc) = match on_a(pb.at[held] + dv, zc, &pb.test.clone(), &tb) {
+                Ok(next) => next,
+                Err(e) => break e,
+            };
             tb = t;
             (pa, ga) = (pb, gb);
             (pb, gb) = (pc, gc);
+            visited.push(pb.at[held]);
             if dv.abs() < tolerance * (1.0 + pb.at[held].abs()) {
                 return Ok((pb, tb, dv.abs()));
             }
+        };
+        // steps stalled at the tests' noise (a corner where they vanish
+        // together, flat): the last point, its error the spread of the
+        // last iterates
+        let last = &visited[visited.len().saturating_sub(STALLED_ITERATES)..];
+        if visited.len() > STALLED_ITERATES {
+            let spread = last.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
+                - last.iter().fold(f64::INFINITY, |m, &v| m.min(v));
+            if spread < 1e-3 {
+                return Ok((pb, tb, spread));
+            }
         }
-        Err("the corner's secant steps did not converge".into())
+        Err(format!("the corner's secant steps {why}"))
     }
 }
+
+/// The iterates of a stalled corner secant whose spread is its error.
+const STALLED_ITERATES: usize = 4;
 
 /// The continuum solution at z lies between the walls (to `slack`, touching
 /// allowed), at the points of [`ContinuumBranch::heights`].
@@ -406,6 +473,76 @@ fn walled(branch: &ContinuumBranch, z: &BranchPoint, slack: f64) -> Result<bool,
 /// How far outside the walls a boundary point's continuum solution may
 /// reach (its touch is located to about the integrator's tolerance).
 const WALL_SLACK: f64 = 1e-5;
+
+/// How many times nearer the other piece's closest points a point must lie
+/// than its own piece's to count as the other's.
+const NEARER: f64 = 4.0;
+
+/// The larger arclength difference of two closest-point pairs.
+fn apart(a: &[f64; 2], b: &[f64; 2]) -> f64 {
+    (a[0] - b[0]).abs().max((a[1] - b[1]).abs())
+}
+
+/// The closest points of a crossing's test.
+fn crossing_points(t: &TestFunction) -> Option<[f64; 2]> {
+    match t {
+        TestFunction::Crossing { s } => Some(*s),
+        _ => None,
+    }
+}
+
+/// The piece each polished point lies on (`jobs`: its walk piece and
+/// index). Where two crossings of the same strands run into one, the
+/// discrete walk can end a crossing piece late or start the next early:
+/// the polished points there lie on the other piece's critical point. A
+/// piece's tail goes to the next piece when each of its points is
+/// [`NEARER`] times nearer (in arclength) the next piece's first closest
+/// points than the piece's own point before the tail: a jump, not the
+/// slide of one crossing's closest points; the next piece's head likewise.
+fn pieces_by_critical_point(
+    pieces: usize,
+    jobs: &[(usize, usize)],
+    points: &[Polished],
+) -> Vec<usize> {
+    let mut piece_of: Vec<usize> = jobs.iter().map(|j| j.0).collect();
+    // the start of the longest tail of `s` (from its second entry on) whose
+    // entries are all nearer `other` than the entry before the tail
+    let tail = |s: &[[f64; 2]], other: &[f64; 2]| -> usize {
+        (1..s.len())
+            .find(|&cut| {
+                s[cut..]
+                    .iter()
+                    .all(|q| NEARER * apart(q, other) < apart(q, &s[cut - 1]))
+            })
+            .unwrap_or(s.len())
+    };
+    for k in 1..pieces {
+        let of = |piece: usize, piece_of: &[usize]| -> Option<(Vec<usize>, Vec<[f64; 2]>)> {
+            let idx: Vec<usize> = (0..points.len())
+                .filter(|&i| piece_of[i] == piece)
+                .collect();
+            let s: Option<Vec<[f64; 2]>> = idx
+                .iter()
+                .map(|&i| crossing_points(&points[i].test))
+                .collect();
+            s.filter(|s| !s.is_empty()).map(|s| (idx, s))
+        };
+        let (Some((ia, sa)), Some((ib, sb))) = (of(k - 1, &piece_of), of(k, &piece_of)) else {
+            continue;
+        };
+        let cut = tail(&sa, &sb[0]);
+        for &i in &ia[cut..] {
+            piece_of[i] = k;
+        }
+        let kept = sa[cut - 1];
+        let rev: Vec<[f64; 2]> = sb.iter().rev().copied().collect();
+        let head = ib.len() - tail(&rev, &kept);
+        for &i in &ib[..head] {
+            piece_of[i] = k - 1;
+        }
+    }
+    piece_of
+}
 
 /// Shoelace area of a closed polygon.
 fn shoelace(points: &[[f64; 2]]) -> f64 {
@@ -497,6 +634,7 @@ pub(super) fn polish_boundary(
             dropped[0]
         ));
     }
+    let piece_of = pieces_by_critical_point(trail.len(), &jobs, &points);
     // the corners, with the tests of their pieces' polished points nearest
     let corners: Vec<(Polished, Polished)> = (1..trail.len())
         .into_par_iter()
@@ -505,17 +643,24 @@ pub(super) fn polish_boundary(
             let (b, _) = &trail[k];
             let corner = pa.last().expect("pieces have points");
             let state = corner.state.as_ref().ok_or("no discrete equilibrium")?;
-            // the test of the piece's nearest polished point (a singular
-            // test's borders at a continuum root), else the discrete corner's
-            let test = |piece: usize, from_end: bool| -> Result<TestFunction, String> {
-                let mut mine = jobs.iter().zip(&points).filter(|(j, _)| j.0 == piece);
-                let nearest = if from_end {
+            // the piece's polished point nearest the corner
+            let nearest = |piece: usize, from_end: bool| -> Option<&Polished> {
+                let mut mine = piece_of
+                    .iter()
+                    .zip(&points)
+                    .filter(|(k, _)| **k == piece)
+                    .map(|(_, p)| p);
+                if from_end {
                     mine.next_back()
                 } else {
                     mine.next()
-                };
-                match nearest {
-                    Some((_, p)) => Ok(p.test.clone()),
+                }
+            };
+            // the test of the piece's nearest polished point (a singular
+            // test's borders at a continuum root), else the discrete corner's
+            let test = |piece: usize, from_end: bool| -> Result<TestFunction, String> {
+                match nearest(piece, from_end) {
+                    Some(p) => Ok(p.test.clone()),
                     None => {
                         let free = free_of(corner.normal);
                         let (at, z) = plane.start(state, free);
@@ -532,14 +677,37 @@ pub(super) fn polish_boundary(
                 normal,
                 ..p.clone()
             };
+            // two crossings that run into one: the corner is where their
+            // closest points merge, on the critical point that persists
+            let merger = match (nearest(k - 1, true), nearest(k, false)) {
+                (Some(pa), Some(pb)) => plane.merger(pa, pb).map(|m| (m, pa, pb)),
+                _ => None,
+            };
             // along both curves: two routes to one corner, whose difference
             // joins its error estimate
-            let along_a = plane
-                .corner(corner, ta.clone(), tb.clone())
-                .map(|(c, tb)| (c.clone(), with(&c, tb, from_b.normal)));
-            let along_b = plane
-                .corner(from_b, tb, ta)
-                .map(|(c, ta)| (with(&c, ta, corner.normal), c));
+            let (along_a, along_b) = if let Some((m, pa, pb)) = merger {
+                let crossing = |m: &TestFunction| match m {
+                    TestFunction::Merging { s } => TestFunction::Crossing { s: *s },
+                    other => other.clone(),
+                };
+                (
+                    plane
+                        .corner_from(pa.at, pa.z, pa.free, pa.normal, ta, m.clone())
+                        .map(|(c, m)| (c.clone(), with(&c, crossing(&m), pb.normal))),
+                    plane
+                        .corner_from(pb.at, pb.z, pb.free, pb.normal, tb, m)
+                        .map(|(c, m)| (with(&c, crossing(&m), pa.normal), c)),
+                )
+            } else {
+                (
+                    plane
+                        .corner(corner, ta.clone(), tb.clone())
+                        .map(|(c, tb)| (c.clone(), with(&c, tb, from_b.normal))),
+                    plane
+                        .corner(from_b, tb, ta)
+                        .map(|(c, ta)| (with(&c, ta, corner.normal), c)),
+                )
+            };
             let (ca, cb) = match (along_a, along_b) {
                 (Ok((mut ca, mut cb)), Ok((other, _))) => {
                     let apart = (0..2)
@@ -585,15 +753,35 @@ pub(super) fn polish_boundary(
             piece.push(corners[k - 1].1.clone());
         }
         piece.extend(
-            jobs.iter()
+            piece_of
+                .iter()
                 .zip(&points)
-                .filter(|(j, _)| j.0 == k)
+                .filter(|(j, _)| **j == k)
                 .map(|(_, p)| p.clone()),
         );
         if k + 1 < trail.len() {
             piece.push(corners[k].0.clone());
         }
-        trim_past_corners(&mut piece, pts, k > 0, k + 1 < trail.len());
+        // the discrete curve's direction at the piece's ends, from the walk
+        // points that stay on it
+        let mine: Vec<[f64; 2]> = piece_of
+            .iter()
+            .zip(&jobs)
+            .filter(|(p, _)| **p == k)
+            .map(|(_, &(kk, i))| trail[kk].1[i].at)
+            .collect();
+        let ends = if mine.len() >= 2 {
+            [
+                [mine[0], mine[1]],
+                [mine[mine.len() - 2], mine[mine.len() - 1]],
+            ]
+        } else {
+            [
+                [pts[0].at, pts[1.min(pts.len() - 1)].at],
+                [pts[pts.len().saturating_sub(2)].at, pts[pts.len() - 1].at],
+            ]
+        };
+        trim_past_corners(&mut piece, ends, k > 0, k + 1 < trail.len());
         pieces.push(piece);
     }
     // gaps wider than the walk's step (where the polish moved a corner
@@ -688,23 +876,20 @@ pub(super) fn polish_boundary(
 }
 
 /// Drop the interior points of a polished piece that the polish moved past
-/// one of its corners (along the discrete piece's direction there).
-fn trim_past_corners(piece: &mut Vec<Polished>, discrete: &[TrailPoint], start: bool, end: bool) {
+/// one of its corners (along the discrete curve's direction `ends` at its
+/// start and end).
+fn trim_past_corners(piece: &mut Vec<Polished>, ends: [[[f64; 2]; 2]; 2], start: bool, end: bool) {
     let direction = |a: [f64; 2], b: [f64; 2]| [b[0] - a[0], b[1] - a[1]];
     let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
-    let n = discrete.len();
-    if n < 2 {
-        return;
-    }
     if start {
-        let t = direction(discrete[0].at, discrete[1].at);
+        let t = direction(ends[0][0], ends[0][1]);
         let c = piece[0].at;
         while piece.len() > 2 && dot(direction(c, piece[1].at), t) <= 0.0 {
             piece.remove(1);
         }
     }
     if end {
-        let t = direction(discrete[n - 2].at, discrete[n - 1].at);
+        let t = direction(ends[1][0], ends[1][1]);
         let c = piece[piece.len() - 1].at;
         while piece.len() > 2 && dot(direction(piece[piece.len() - 2].at, c), t) <= 0.0 {
             piece.remove(piece.len() - 2);
@@ -715,6 +900,46 @@ fn trim_past_corners(piece: &mut Vec<Polished>, discrete: &[TrailPoint], start: 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A polished point with a crossing's closest points at `s`.
+    fn crossing_point(s: [f64; 2]) -> Polished {
+        Polished {
+            at: [0.0, 0.0],
+            error: 0.0,
+            z: BranchPoint::zeros(),
+            free: 0,
+            test: TestFunction::Crossing { s },
+            normal: [0.0, 1.0],
+        }
+    }
+
+    #[test]
+    fn a_crossing_pieces_tail_on_the_next_pieces_critical_point_moves_to_it() {
+        // piece 0's closest points slide towards piece 1's, then its last
+        // three points sit on piece 1's critical point (the walk ended it late)
+        let s0: Vec<[f64; 2]> = [0.04, 0.06, 0.08, 0.1, 0.1076, 0.1157, 0.1155, 0.1152]
+            .iter()
+            .map(|&a| [a, a + 0.77])
+            .collect();
+        // the pieces each point lies on, for piece 1's closest points `s1`
+        let pieces_with = |s1: &[[f64; 2]]| {
+            let jobs: Vec<(usize, usize)> = (0..s0.len())
+                .map(|i| (0, i))
+                .chain((0..s1.len()).map(|i| (1, i)))
+                .collect();
+            let points: Vec<Polished> = s0.iter().chain(s1).map(|&s| crossing_point(s)).collect();
+            pieces_by_critical_point(2, &jobs, &points)
+        };
+        assert_eq!(
+            pieces_with(&[[0.1151, 0.8849], [0.1140, 0.8860], [0.11, 0.89]]),
+            [0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1]
+        );
+        // crossings of other strands, far apart: nothing moves
+        assert_eq!(
+            pieces_with(&[[0.3, 0.6], [0.31, 0.61]]),
+            [0, 0, 0, 0, 0, 0, 0, 0, 1, 1]
+        );
+    }
 
     #[test]
     fn nested_polygons_of_a_circle_extrapolate_to_its_area() {
