@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import os
+from enum import Enum
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
@@ -35,6 +36,7 @@ __all__ = [
     "Scene",
     "Equilibrium",
     "Event",
+    "EventKind",
     "Branch",
     "Recording",
     "KnotrodError",
@@ -242,50 +244,103 @@ class Equilibrium:
     ``walled``, ``stable``, ``lowest_eigenvalues``, ``omega_squared``,
     ``good_knot``, ``z_star``, ``delta``, ``phi_over_2pi``, ``branch``... —
     every field of the JSON summary's equilibria (see ``to_dict()``).
+
+    An equilibrium of a :class:`Branch` is converted from the Rust result
+    when first read (its scalars on the first scalar read, its arrays on the
+    first array read) and kept: a branch of hundreds of points costs only
+    what is read of it.
     """
 
     def __init__(self, data: Dict[str, Any]) -> None:
         self._data = data
+        self._source: Any = None
+        self._index = 0
+        self._scalars_read = self._arrays_read = True
+
+    @classmethod
+    def _lazy(cls, source: Any, index: int) -> "Equilibrium":
+        """Point ``index`` of a run's ``_knotrod.Points``, read on access."""
+        eq = cls.__new__(cls)
+        eq._data = {}
+        eq._source = source
+        eq._index = index
+        eq._scalars_read = eq._arrays_read = False
+        return eq
+
+    def _scalars_loaded(self) -> Dict[str, Any]:
+        if not self._scalars_read:
+            self._data.update(self._source.scalars(self._index))
+            self._scalars_read = True
+        return self._data
+
+    def _all_loaded(self) -> Dict[str, Any]:
+        self._scalars_loaded()
+        if not self._arrays_read:
+            self._data.update(self._source.arrays(self._index))
+            self._arrays_read = True
+        return self._data
 
     def __getattr__(self, name: str) -> Any:
+        # only names not found the usual way; private and dunder probes
+        # (copy, numpy, pandas) must not convert anything
+        if name.startswith("_") or "_data" not in self.__dict__:
+            raise AttributeError(name)
+        if name == "state_json":
+            if name not in self._data and self._source is not None:
+                self._data[name] = self._source.state_json(self._index)
+            data = self._data
+        elif name in _ARRAYS:
+            data = self._all_loaded()
+        else:
+            data = self._scalars_loaded()
         try:
-            return self.__dict__["_data"][name]
+            return data[name]
         except KeyError:
             raise AttributeError(name) from None
 
+    def __reduce__(self) -> Any:
+        # pickled and copied whole: the Rust result it reads from is not
+        # picklable
+        data = dict(self._all_loaded())
+        if "state_json" not in data and self._source is not None:
+            data["state_json"] = self._source.state_json(self._index)
+        return (type(self), (data,))
+
     def __dir__(self) -> List[str]:
-        return sorted(set(super().__dir__()) | set(self._data) | {"d1", "d2", "d3"})
+        return sorted(set(super().__dir__()) | set(self._scalars_loaded()) | set(_ARRAYS) | {"d1", "d2", "d3"})
 
     @property
     def d1(self) -> np.ndarray:
         """d1 of each edge, (N+1, 3)."""
-        return self._data["directors"][:, 0, :]
+        return self.directors[:, 0, :]
 
     @property
     def d2(self) -> np.ndarray:
         """d2 of each edge, (N+1, 3)."""
-        return self._data["directors"][:, 1, :]
+        return self.directors[:, 1, :]
 
     @property
     def d3(self) -> np.ndarray:
         """d3 (the tangent) of each edge, (N+1, 3)."""
-        return self._data["directors"][:, 2, :]
+        return self.directors[:, 2, :]
 
     @property
     def segments(self) -> int:
         """N."""
+        if not self._arrays_read:
+            return self._source.segments(self._index)
         return len(self._data["s_vertices"])
 
     def scalars(self) -> Dict[str, Any]:
         """The measurements without the arrays."""
-        return {k: v for k, v in self._data.items() if k not in _ARRAYS and k != "state_json"}
+        return {k: v for k, v in self._scalars_loaded().items() if k not in _ARRAYS and k != "state_json"}
 
     def to_dict(self) -> Dict[str, Any]:
         """Everything as a plain dict (arrays as numpy arrays)."""
-        return {k: v for k, v in self._data.items() if k != "state_json"}
+        return {k: v for k, v in self._all_loaded().items() if k != "state_json"}
 
     def __repr__(self) -> str:
-        d = self._data
+        d = self._scalars_loaded()
         return (
             f"Equilibrium(z_star={d.get('z_star')}, delta={d.get('delta')}, "
             f"phi_over_2pi={d.get('phi_over_2pi')}, twist={d.get('twist')}, "
@@ -293,13 +348,51 @@ class Equilibrium:
         )
 
 
-class Event:
-    """An event along a branch or loading path: ``kind`` (wall, crossing,
-    branch point, fold, jump, ...), ``label`` as in the paper's figures (W1,
-    W2, X, S, F1...), where (``phi_over_2pi``, ``z_star``, ``delta``),
-    ``twist``, ``branch`` and ``detail``; ``continuum`` when polished."""
+class EventKind(str, Enum):
+    """What happens at an event. A ``str``: each kind equals its name
+    (``EventKind.WALL == "wall"``), prints and formats as it, and is written
+    as it to JSON."""
 
-    kind: str
+    WALL = "wall"
+    """The rod touches a wall (enters or leaves the walled region)."""
+    CROSSING = "crossing"
+    """The centreline passes through itself or a ray (the link jumps by ±2)."""
+    STABILITY = "stability"
+    """The count of negative eigenvalues changes."""
+    FOLD = "fold"
+    """The parameter turns back along the branch."""
+    BRANCH_POINT = "branch_point"
+    """A branch point: another branch crosses this one."""
+    JUMP = "jump"
+    """The rod jumps off its branch (loading paths)."""
+    KNOT_CHANGE = "knot_change"
+    """The knot type of the ray closure changes."""
+    END = "end"
+    """The branch ends (lost, or a switch failed)."""
+    CONTACT_LOST = "contact_lost"
+    """The last contact opens (loading with contact)."""
+
+    # the plain string everywhere a string is expected (Python 3.12 prints
+    # a mixed-in Enum as "EventKind.WALL")
+    def __str__(self) -> str:
+        return str.__str__(self)
+
+    def __format__(self, spec: str) -> str:
+        return str.__format__(self.value, spec)
+
+    def __hash__(self) -> int:
+        return str.__hash__(self)
+
+
+class Event:
+    """An event along a branch or loading path: ``kind`` (an
+    :class:`EventKind`, equal to its name: ``"wall"``, ``"crossing"``,
+    ``"branch_point"``, ``"fold"``, ``"jump"``, ...), ``label`` as in the
+    paper's figures (W1, W2, X, S, F1...), where (``phi_over_2pi``,
+    ``z_star``, ``delta``), ``twist``, ``branch`` and ``detail``;
+    ``continuum`` when polished."""
+
+    kind: Union["EventKind", str]
     label: str
     phi_over_2pi: float
     z_star: float
@@ -314,13 +407,18 @@ class Event:
             setattr(self, k, v)
         if "continuum" not in data:
             self.continuum = None
+        try:
+            self.kind = EventKind(data.get("kind"))
+        except ValueError:
+            # a kind this version does not know (a newer recording): its name
+            pass
 
     def to_dict(self) -> Dict[str, Any]:
         """The event as a plain dict."""
         return dict(self._data)
 
     def __repr__(self) -> str:
-        return f"Event({self.label!r}, {self.kind!r}, phi_over_2pi={self.phi_over_2pi:.6f}, branch={self.branch})"
+        return f"Event({self.label!r}, {str(self.kind)!r}, phi_over_2pi={self.phi_over_2pi:.6f}, branch={self.branch})"
 
 
 _COLUMNS = (
@@ -358,12 +456,36 @@ class Branch:
     scalars as numpy arrays by name, which ``pandas.DataFrame(...)`` takes as
     it is; ``event_columns()`` the same for the events. ``interrupted`` is
     True for the partial result of a run stopped by Ctrl-C.
+
+    The points of a run stay Rust values until read: ``columns()`` is built
+    from them directly, and a point's scalars and arrays are converted when
+    it is first read (see :class:`Equilibrium`).
     """
 
-    def __init__(self, points: List[Dict[str, Any]], events: List[Dict[str, Any]], interrupted: bool = False) -> None:
-        self.points = [Equilibrium(p) for p in points]
+    def __init__(self, points: Union["_knotrod.Points", Sequence[Union[Dict[str, Any], Equilibrium]]], events: List[Dict[str, Any]], interrupted: bool = False) -> None:
+        if isinstance(points, _knotrod.Points):
+            # a run's result: each point converted when first read
+            self._source: Any = points
+            self.points = [Equilibrium._lazy(points, k) for k in range(len(points))]
+        else:
+            self._source = None
+            self.points = [p if isinstance(p, Equilibrium) else Equilibrium(p) for p in points]
         self.events = [Event(e) for e in events]
         self.interrupted = interrupted
+
+    def __getstate__(self) -> Dict[str, Any]:
+        # the Rust result is not picklable; the points pickle whole
+        state = dict(self.__dict__)
+        state["_source"] = None
+        return state
+
+    def _unchanged(self) -> bool:
+        """The points are still the run's, in its order (the columns can
+        then be taken from the Rust result)."""
+        src = self._source
+        if src is None or len(self.points) != len(src):
+            return False
+        return all(getattr(p, "_source", None) is src and p._index == k for k, p in enumerate(self.points))
 
     def __len__(self) -> int:
         return len(self.points)
@@ -371,7 +493,10 @@ class Branch:
     def columns(self) -> Dict[str, np.ndarray]:
         """One numpy array per scalar, one entry per point; n0 and m0 as
         n0_1..n0_3, m0_1..m0_3, and the lowest eigenvalue and ω²."""
-        pts = [p._data for p in self.points]
+        if self._unchanged():
+            # built in Rust, no point converted
+            return self._source.columns()
+        pts = [p._scalars_loaded() for p in self.points]
         cols: Dict[str, np.ndarray] = {k: np.array([p.get(k) for p in pts]) for k in _COLUMNS}
         for name in ("n0", "m0"):
             for c in range(3):
@@ -383,8 +508,10 @@ class Branch:
     def event_columns(self) -> Dict[str, np.ndarray]:
         """The events' fields as arrays (kind, label, phi_over_2pi, z_star,
         delta, twist, branch)."""
-        keys = ("kind", "label", "phi_over_2pi", "z_star", "delta", "twist", "branch")
-        return {k: np.array([getattr(e, k) for e in self.events]) for k in keys}
+        keys = ("label", "phi_over_2pi", "z_star", "delta", "twist", "branch")
+        cols = {"kind": np.array([str(e.kind) for e in self.events])}
+        cols.update({k: np.array([getattr(e, k) for e in self.events]) for k in keys})
+        return cols
 
     def event(self, label: str) -> Event:
         """The first event with this label (W1, W2, X, S, F1, ...)."""

@@ -3,7 +3,10 @@
 //! It does no physics: each function parses a scene, calls one library entry
 //! point with the GIL released, and turns the result into Python objects
 //! (plain dicts, lists and numpy arrays); the pure-Python package
-//! (python/knotrod/) wraps those in documented classes. Every library error
+//! (python/knotrod/) wraps those in documented classes. A run's equilibria
+//! stay Rust values (`Points`) until Python asks for one: most of a
+//! branch's hundreds of points are never read one by one, and converting
+//! them all would cost more than the CLI's whole summary. Every library error
 //! becomes a `SceneError` or `SolveError`, a panic a `SolveError` (caught
 //! here, never unwound into the interpreter), and Ctrl-C during a run a
 //! `KeyboardInterrupt` carrying what was computed.
@@ -21,8 +24,9 @@ use knotrod::study::map::{Line, LineStore};
 use knotrod::study::verify::{SolutionCheck, VerifyOptions, verify_all};
 use knotrod::{knot_type as lib_knot_type, writhe_closed};
 use nalgebra::Vector3;
-use numpy::{PyArray1, PyArray2, PyArray3};
-use pyo3::exceptions::{PyException, PyValueError};
+use numpy::{Element, PyArray1, PyArrayMethods};
+use pyo3::IntoPyObjectExt;
+use pyo3::exceptions::{PyException, PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -221,10 +225,41 @@ fn to_py<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<
     py.import("json")?.call_method1("loads", (text,))
 }
 
+/// Python objects from a JSON value, directly (no text in between).
+fn value_to_py<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    use serde_json::Value;
+    match value {
+        Value::Null => Ok(py.None().into_bound(py)),
+        Value::Bool(b) => b.into_bound_py_any(py),
+        Value::Number(n) => match (n.as_i64(), n.as_u64()) {
+            (Some(i), _) => i.into_bound_py_any(py),
+            (None, Some(u)) => u.into_bound_py_any(py),
+            _ => n.as_f64().unwrap_or(f64::NAN).into_bound_py_any(py),
+        },
+        Value::String(s) => s.into_bound_py_any(py),
+        Value::Array(items) => {
+            let list = PyList::empty(py);
+            for item in items {
+                list.append(value_to_py(py, item)?)?;
+            }
+            Ok(list.into_any())
+        }
+        Value::Object(map) => {
+            let d = PyDict::new(py);
+            for (k, v) in map {
+                d.set_item(k, value_to_py(py, v)?)?;
+            }
+            Ok(d.into_any())
+        }
+    }
+}
+
 /// An (n, 3) array.
-fn rows<'py>(py: Python<'py>, v: &[[f64; 3]]) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let rows: Vec<Vec<f64>> = v.iter().map(|r| r.to_vec()).collect();
-    Ok(PyArray2::from_vec2(py, &rows)?)
+fn rows<'py>(py: Python<'py>, v: &[[f64; 3]]) -> PyResult<Bound<'py, PyAny>> {
+    let flat: Vec<f64> = v.iter().flatten().copied().collect();
+    Ok(PyArray1::from_vec(py, flat)
+        .reshape([v.len(), 3])?
+        .into_any())
 }
 
 /// The arrays of a state along s (nodes, directors, strains, n(s), m(s) and
@@ -239,23 +274,30 @@ fn add_arrays(
     let nodes: Vec<[f64; 3]> = state.nodes.iter().map(|x| [x[0], x[1], x[2]]).collect();
     d.set_item("nodes", rows(py, &nodes)?)?;
     d.set_item("theta", PyArray1::from_slice(py, &state.theta))?;
-    let directors: Vec<Vec<Vec<f64>>> = p
-        .directors
-        .iter()
-        .map(|f| f.iter().map(|v| v.to_vec()).collect())
-        .collect();
-    d.set_item("directors", PyArray3::from_vec3(py, &directors)?)?;
+    let directors: Vec<f64> = p.directors.iter().flatten().flatten().copied().collect();
+    let directors = PyArray1::from_vec(py, directors).reshape([p.directors.len(), 3, 3])?;
+    d.set_item("directors", directors)?;
     d.set_item("strains", rows(py, &p.strains)?)?;
     d.set_item("force", rows(py, &p.force)?)?;
     d.set_item("moment", rows(py, &p.moment)?)?;
     d.set_item("s_nodes", PyArray1::from_slice(py, &p.s_nodes))?;
     d.set_item("s_edges", PyArray1::from_slice(py, &p.s_edges))?;
     d.set_item("s_vertices", PyArray1::from_slice(py, &p.s_vertices))?;
-    d.set_item(
-        "state_json",
-        serde_json::to_string(state).unwrap_or_default(),
-    )?;
     Ok(())
+}
+
+/// The state as JSON text (what `[initial] shape = "file"` reads).
+fn state_json(state: &knotrod::RodState) -> String {
+    serde_json::to_string(state).unwrap_or_default()
+}
+
+/// An equilibrium's scalars (the JSON summary's fields, without its state).
+fn scalars_dict<'py>(py: Python<'py>, eq: &Equilibrium) -> PyResult<Bound<'py, PyDict>> {
+    let mut value = serde_json::to_value(eq).map_err(|e| KnotrodError::new_err(e.to_string()))?;
+    if let Some(o) = value.as_object_mut() {
+        o.remove("state");
+    }
+    Ok(value_to_py(py, &value)?.cast_into::<PyDict>()?)
 }
 
 /// An equilibrium as a dict: its scalars (the JSON summary's fields) and
@@ -265,13 +307,127 @@ fn equilibrium_dict<'py>(
     eq: &Equilibrium,
     model: &RodModel,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut value = serde_json::to_value(eq).map_err(|e| KnotrodError::new_err(e.to_string()))?;
-    if let Some(o) = value.as_object_mut() {
-        o.remove("state");
-    }
-    let d = to_py(py, &value)?.cast_into::<PyDict>()?;
+    let d = scalars_dict(py, eq)?;
     add_arrays(py, &d, model, &eq.state)?;
+    d.set_item("state_json", state_json(&eq.state))?;
     Ok(d)
+}
+
+/// One value per equilibrium as a numpy array.
+fn column<'py, T: Element>(
+    py: Python<'py>,
+    eqs: &[Equilibrium],
+    f: impl Fn(&Equilibrium) -> T,
+) -> Bound<'py, PyArray1<T>> {
+    PyArray1::from_iter(py, eqs.iter().map(f))
+}
+
+/// The equilibria of a run, kept as the library's values: each becomes
+/// Python objects (a dict of scalars, a dict of arrays) only when asked for,
+/// so that a branch costs no more through Python than through the CLI.
+#[pyclass(name = "Points", module = "knotrod._knotrod", frozen)]
+struct PyPoints {
+    /// The equilibria, in the order computed.
+    equilibria: Vec<Equilibrium>,
+    /// The rod model they are states of (the scene's, at the run's N).
+    model: RodModel,
+}
+
+impl PyPoints {
+    /// The equilibrium at `index` (negative: from the end, as Python's).
+    fn at(&self, index: isize) -> PyResult<&Equilibrium> {
+        let n = self.equilibria.len() as isize;
+        let k = if index < 0 { index + n } else { index };
+        if (0..n).contains(&k) {
+            Ok(&self.equilibria[k as usize])
+        } else {
+            Err(PyIndexError::new_err(format!(
+                "point {index} of {n} is out of range"
+            )))
+        }
+    }
+}
+
+#[pymethods]
+impl PyPoints {
+    /// The number of equilibria.
+    fn __len__(&self) -> usize {
+        self.equilibria.len()
+    }
+
+    /// The scalars of equilibrium `index` (the JSON summary's fields).
+    fn scalars<'py>(&self, py: Python<'py>, index: isize) -> PyResult<Bound<'py, PyDict>> {
+        scalars_dict(py, self.at(index)?)
+    }
+
+    /// The arrays along s of equilibrium `index` (nodes, theta, directors,
+    /// strains, force, moment, s_nodes, s_edges, s_vertices).
+    fn arrays<'py>(&self, py: Python<'py>, index: isize) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        add_arrays(py, &d, &self.model, &self.at(index)?.state)?;
+        Ok(d)
+    }
+
+    /// The state of equilibrium `index` as JSON text.
+    fn state_json(&self, index: isize) -> PyResult<String> {
+        Ok(state_json(&self.at(index)?.state))
+    }
+
+    /// The N of equilibrium `index`.
+    fn segments(&self, index: isize) -> PyResult<usize> {
+        Ok(self.at(index)?.state.segments())
+    }
+
+    /// The scalars as numpy arrays, one entry per equilibrium: the columns
+    /// of `knotrod.Branch.columns()`, in its order.
+    fn columns<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let e = &self.equilibria[..];
+        let d = PyDict::new(py);
+        d.set_item("branch", column(py, e, |q| q.branch as i64))?;
+        d.set_item("leg", column(py, e, |q| q.leg as i64))?;
+        d.set_item("z_star", column(py, e, |q| q.z_star))?;
+        d.set_item("delta", column(py, e, |q| q.delta))?;
+        d.set_item("phi_over_2pi", column(py, e, |q| q.phi_over_2pi))?;
+        d.set_item("energy", column(py, e, |q| q.energy))?;
+        d.set_item("twist", column(py, e, |q| q.twist))?;
+        d.set_item("writhe", column(py, e, |q| q.writhe))?;
+        d.set_item("link", column(py, e, |q| q.link))?;
+        d.set_item(
+            "knot_determinant",
+            column(py, e, |q| q.knot_determinant as i64),
+        )?;
+        d.set_item("knotted", column(py, e, |q| q.knotted))?;
+        d.set_item("walled", column(py, e, |q| q.walled))?;
+        d.set_item("stable", column(py, e, |q| q.stable))?;
+        d.set_item(
+            "negative_eigenvalues",
+            column(py, e, |q| q.negative_eigenvalues as i64),
+        )?;
+        d.set_item("good_knot", column(py, e, |q| q.good_knot))?;
+        d.set_item("min_z", column(py, e, |q| q.min_z))?;
+        d.set_item("max_z", column(py, e, |q| q.max_z))?;
+        d.set_item("wall_distance", column(py, e, |q| q.wall_distance))?;
+        d.set_item("min_self_distance", column(py, e, |q| q.min_self_distance))?;
+        d.set_item("contact_force", column(py, e, |q| q.contact_force))?;
+        d.set_item("iterations", column(py, e, |q| q.iterations as i64))?;
+        d.set_item("converged", column(py, e, |q| q.converged))?;
+        for c in 0..3 {
+            d.set_item(format!("n0_{}", c + 1), column(py, e, |q| q.n0[c]))?;
+        }
+        for c in 0..3 {
+            d.set_item(format!("m0_{}", c + 1), column(py, e, |q| q.m0[c]))?;
+        }
+        let first = |v: &[f64]| v.first().copied().unwrap_or(f64::NAN);
+        d.set_item(
+            "lowest_eigenvalue",
+            column(py, e, |q| first(&q.lowest_eigenvalues)),
+        )?;
+        d.set_item(
+            "lowest_omega_squared",
+            column(py, e, |q| first(&q.omega_squared)),
+        )?;
+        Ok(d)
+    }
 }
 
 /// Solve a scene's equilibrium (its start, solved and measured).
@@ -309,9 +465,10 @@ struct RunOutcome {
 
 /// Run a scene (a branch, a sweep of branches or a loading path): every
 /// equilibrium is kept, handed to `progress` (a dict of its scalars) and
-/// recorded (MCAP) when `record` names a file. Returns (equilibria, events);
-/// Ctrl-C stops it after the current equilibrium with a KeyboardInterrupt
-/// whose `partial` is (equilibria, events) and the recording finalised.
+/// recorded (MCAP) when `record` names a file. Returns (points, events), the
+/// equilibria as `Points`; Ctrl-C stops it after the current equilibrium
+/// with a KeyboardInterrupt whose `partial` is (points, events) and the
+/// recording finalised.
 #[pyfunction]
 #[pyo3(signature = (scene, segments=None, progress=None, record=None, allow_large=false))]
 fn run<'py>(
@@ -321,7 +478,7 @@ fn run<'py>(
     progress: Option<Py<PyAny>>,
     record: Option<PathBuf>,
     allow_large: bool,
-) -> PyResult<(Bound<'py, PyList>, Bound<'py, PyList>)> {
+) -> PyResult<(Bound<'py, PyPoints>, Bound<'py, PyList>)> {
     check_segments(segments)?;
     let s = &scene.scene;
     s.check_budget(Job::Run, segments, allow_large)
@@ -390,22 +547,30 @@ fn run<'py>(
             .map_err(|e| KnotrodError::new_err(e.to_string())),
         None => Ok(()),
     };
-    let eqs = PyList::empty(py);
-    for eq in &outcome.equilibria {
-        eqs.append(equilibrium_dict(py, eq, &model)?)?;
-    }
-    let events = to_py(py, &outcome.events)?.cast_into::<PyList>()?;
-    if let Some(err) = outcome.python {
+    let RunOutcome {
+        equilibria,
+        events,
+        error,
+        python,
+    } = outcome;
+    // the equilibria stay Rust values; Python converts those it reads
+    let error = match (&python, &error) {
+        (None, Some(e)) => Some(study_error(py, e, equilibria.last(), &model)),
+        _ => None,
+    };
+    let points = Bound::new(py, PyPoints { equilibria, model })?;
+    let events = to_py(py, &events)?.cast_into::<PyList>()?;
+    if let Some(err) = python {
         let value = err.value(py);
-        let _ = value.setattr("partial", (eqs.clone(), events.clone()));
+        let _ = value.setattr("partial", (points.clone(), events.clone()));
         let _ = value.setattr("recording", record.clone());
         return Err(err);
     }
-    if let Some(e) = &outcome.error {
-        return Err(study_error(py, e, outcome.equilibria.last(), &model));
+    if let Some(err) = error {
+        return Err(err);
     }
     finished?;
-    Ok((eqs, events))
+    Ok((points, events))
 }
 
 /// Lines kept in memory only: a map from Python does not resume.
@@ -562,6 +727,7 @@ fn read_recording<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RecordingPart
         let msg = detached(py, || parse_state(&path, &bytes, k as u64))?.map_err(io)?;
         let d = to_py(py, scalars)?.cast_into::<PyDict>()?;
         add_arrays(py, &d, &msg.model, &msg.state)?;
+        d.set_item("state_json", state_json(&msg.state))?;
         states.append(d)?;
     }
     Ok((
@@ -581,6 +747,7 @@ fn _knotrod(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SolveError", py.get_type::<SolveError>())?;
     m.add("INTERRUPTED", INTERRUPTED)?;
     m.add_class::<PyScene>()?;
+    m.add_class::<PyPoints>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(map_scene, m)?)?;

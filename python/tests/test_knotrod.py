@@ -245,3 +245,49 @@ def test_ctrl_c_interrupts_a_long_branch_cleanly(root, tmp_path):
     # the recording was finalised with what was computed
     r = knotrod.read_recording(rec)
     assert len(r) == count
+
+
+def test_branch_points_are_converted_on_access(root):
+    scene = knotrod.Scene.from_toml(root / "scenes/appendix_d.toml").with_(
+        continuation={"parameter": "phi", "range": [0.76, 0.83], "direction": "up"},
+    )
+    b = knotrod.branch(scene, segments=40)
+    assert len(b) > 3 and not any(p._scalars_read or p._arrays_read for p in b.points)
+    # the columns come from the Rust result, no point converted, and agree
+    # with the points' own scalars
+    cols = b.columns()
+    assert not any(p._scalars_read for p in b.points)
+    # a point: its scalars when first read, its arrays when first read, the
+    # same objects after
+    p = b.points[-1]
+    assert p.segments == 40 and not p._scalars_read
+    assert p.twist == cols["twist"][-1] and not p._arrays_read
+    assert p.nodes is p.nodes and p.to_dict()["nodes"] is p.nodes
+    assert b.points[-1] is p and p.d3.shape == (41, 3)
+    # the points converted agree with the columns
+    eager = knotrod.Branch([p.to_dict() for p in b.points], [e.to_dict() for e in b.events]).columns()
+    assert list(cols) == list(eager)
+    for k, v in cols.items():
+        assert v.dtype == eager[k].dtype and np.array_equal(v, eager[k], equal_nan=True), k
+    # pickled and copied whole
+    import copy
+    import pickle
+
+    q = pickle.loads(pickle.dumps(b.points[1]))
+    assert np.array_equal(q.force, b.points[1].force) and q.energy == b.points[1].energy
+    assert copy.deepcopy(b.points[2]).link == b.points[2].link
+    c = pickle.loads(pickle.dumps(b))
+    assert np.array_equal(c.columns()["twist"], cols["twist"])
+    with pytest.raises(AttributeError):
+        b.points[0].no_such_field
+
+
+def test_event_kinds_are_strings_and_an_enum(root):
+    scene = knotrod.Scene.from_toml(root / "scenes/appendix_d.toml").with_(
+        continuation={"parameter": "phi", "range": [0.76, 0.83], "direction": "up"},
+    )
+    w = knotrod.branch(scene, segments=40).event("W1")
+    assert w.kind is knotrod.EventKind.WALL and w.kind == "wall"
+    assert "wall" in {w.kind} and f"{w.kind:>5}" == " wall" and str(w.kind) == "wall"
+    assert json.loads(json.dumps(w.to_dict()))["kind"] == "wall"
+    assert knotrod.EventKind("branch_point") is knotrod.EventKind.BRANCH_POINT
