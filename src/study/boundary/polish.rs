@@ -459,6 +459,9 @@ impl Plane<'_> {
     }
 }
 
+/// Passes retrying failed boundary points from their polished neighbours.
+const RETRY_PASSES: usize = 3;
+
 /// The iterates of a stalled corner secant whose spread is its error.
 const STALLED_ITERATES: usize = 4;
 
@@ -610,7 +613,50 @@ pub(super) fn polish_boundary(
         .par_iter()
         .map(|&(k, i)| plane.point(&trail[k].1[i], &trail[k].0))
         .collect();
-    let retried = first;
+    // a point that fails from its discrete start (too far from the
+    // continuum at small N) is tried again from its piece's nearest polished
+    // point, on its own line; passes repeat while they rescue points
+    let mut retried = first;
+    for _ in 0..RETRY_PASSES {
+        let again: Vec<(usize, Result<Polished, String>)> = (0..jobs.len())
+            .into_par_iter()
+            .filter(|&n| retried[n].is_err())
+            .filter_map(|n| {
+                let (k, i) = jobs[n];
+                let near = (0..jobs.len())
+                    .filter(|&m| jobs[m].0 == k && retried[m].is_ok())
+                    .min_by_key(|&m| jobs[m].1.abs_diff(i))?;
+                let q = retried[near].as_ref().ok()?;
+                // on the discrete point's line, started at the neighbour's
+                // value (the curve there), so that the reach is measured
+                // from the continuum curve, not from the discrete one
+                let p = &trail[k].1[i];
+                let free = free_of(p.normal);
+                let mut at = p.at;
+                at[free] = q.at[free];
+                let r = plane.near_neighbours(at, free, &[(q, 1.0)], 2.0 * spacing);
+                Some((n, r))
+            })
+            .collect();
+        let mut rescued = 0;
+        for (n, r) in again {
+            match (r, &mut retried[n]) {
+                (Ok(p), slot) => {
+                    *slot = Ok(p);
+                    rescued += 1;
+                }
+                (Err(e), Err(first)) => {
+                    if !first.contains("from its piece's nearest") {
+                        *first = format!("{first}; from its piece's nearest polished point: {e}");
+                    }
+                }
+                (Err(_), Ok(_)) => {}
+            }
+        }
+        if rescued == 0 {
+            break;
+        }
+    }
     // a point that fails (its discrete start too far from the continuum,
     // next to a branch point say) is left out, and said so: its
     // neighbours' middle is polished instead
@@ -699,12 +745,28 @@ pub(super) fn polish_boundary(
                         .map(|(c, m)| (with(&c, crossing(&m), pa.normal), c)),
                 )
             } else {
+                // from the discrete corner, else (at small N, far from the
+                // continuum's) from the piece's polished point nearest it
+                let from_polished = |p: Option<&Polished>, ta: &TestFunction, tb: &TestFunction| {
+                    p.ok_or_else(|| "no polished point".to_string())
+                        .and_then(|p| {
+                            plane.corner_from(p.at, p.z, p.free, p.normal, ta.clone(), tb.clone())
+                        })
+                };
                 (
                     plane
                         .corner(corner, ta.clone(), tb.clone())
+                        .or_else(|e| {
+                            from_polished(nearest(k - 1, true), &ta, &tb)
+                                .map_err(|f| format!("{e}; from the nearest polished point: {f}"))
+                        })
                         .map(|(c, tb)| (c.clone(), with(&c, tb, from_b.normal))),
                     plane
-                        .corner(from_b, tb, ta)
+                        .corner(from_b, tb.clone(), ta.clone())
+                        .or_else(|e| {
+                            from_polished(nearest(k, false), &tb, &ta)
+                                .map_err(|f| format!("{e}; from the nearest polished point: {f}"))
+                        })
                         .map(|(c, ta)| (with(&c, ta, corner.normal), c)),
                 )
             };
