@@ -35,7 +35,8 @@ pub struct Workload {
     /// Peak resident memory of the process so far (Linux VmHWM), bytes.
     pub peak_bytes: u64,
     /// Largest error of its answers against the converged continuum ones
-    /// (events: in φ/2π), where it has answers to compare.
+    /// (events: in φ/2π), where it has answers to compare; for a polished
+    /// island, its area's relative error estimate.
     pub accuracy: Option<f64>,
 }
 
@@ -300,14 +301,33 @@ fn island_workloads(fig7: &Scene) -> Result<Vec<Workload>> {
         }
         Ok(())
     })?);
-    workloads.push(timed("figure_7_island_boundary_walk", 100, || {
-        let spec = fig7.map.clone().context("fig7 scene has a [map]")?;
-        let t = crate::study::boundary::trace_island(fig7, &spec, None, &|_, _| {})?;
-        if !t.closed {
-            crate::report::error::fail!("boundary walk did not close: {:?}", t.stopped);
-        }
-        Ok(())
-    })?);
+    // the walk alone, then the walk with its boundary polished on the
+    // continuum (its accuracy: the polished area's relative error estimate)
+    for polish in [false, true] {
+        let name = if polish {
+            "figure_7_island_boundary_polished"
+        } else {
+            "figure_7_island_boundary_walk"
+        };
+        let mut area_error = None;
+        let mut w = timed(name, 100, || {
+            let mut spec = fig7.map.clone().context("fig7 scene has a [map]")?;
+            spec.polish = polish;
+            let t = crate::study::boundary::trace_island(fig7, &spec, None, &|_, _| {})?;
+            if !t.closed {
+                crate::report::error::fail!("boundary walk did not close: {:?}", t.stopped);
+            }
+            if polish {
+                let p = t.polished.as_ref().with_context(|| {
+                    format!("the boundary was not polished: {:?}", t.not_polished)
+                })?;
+                area_error = Some(p.area_error / p.area);
+            }
+            Ok(())
+        })?;
+        w.accuracy = area_error;
+        workloads.push(w);
+    }
     Ok(workloads)
 }
 
