@@ -617,11 +617,28 @@ def loading(
     return _run(s, segments, progress, record, allow_large)
 
 
-def map(scene: SceneLike, segments: Optional[int] = None, allow_large: bool = False) -> Dict[str, Any]:  # noqa: A001 - mirrors `knotrod map`
-    """Map the good-knot region (``knotrod map``: one branch per line of
-    the scene's ``[map]``, in parallel): the map as a dict (``lines`` with
-    their good intervals, ``grid``, ``area``, ...), without the boundary walk."""
-    return _knotrod.map_scene(_scene(scene), segments, allow_large)
+def map(  # noqa: A001 - mirrors `knotrod map`
+    scene: SceneLike,
+    segments: Optional[int] = None,
+    progress: Optional[Callable[[Dict[str, Any]], Any]] = None,
+    cache: Optional[PathLike] = None,
+    allow_large: bool = False,
+) -> Dict[str, Any]:
+    """Map the good-knot region as ``knotrod map`` does: the boundary walk
+    from the scene's good knot (``traced``: its pieces, corners, area, and
+    ``polished`` on the continuum when the scene's ``[map] polish = true``),
+    then one branch per line of the ``[map]``, in parallel. The map as a dict
+    (``lines`` with their good intervals, ``grid``, ``area``, ``traced``...).
+
+    ``progress`` is called with a dict per boundary point (``stage``
+    "boundary") and per line (``stage`` "line"). ``cache`` names a folder
+    keeping the walk and the lines: a rerun resumes from it. Ctrl-C stops the
+    map (once the walk, or the lines in progress, finish) with a
+    KeyboardInterrupt whose ``partial`` holds ``traced`` and the ``lines``
+    computed."""
+    return _knotrod.map_scene(
+        _scene(scene), segments, progress, None if cache is None else os.fspath(cache), allow_large
+    )
 
 
 def verify(

@@ -50,7 +50,13 @@ def run(
     record: Optional[str] = None,
     allow_large: bool = False,
 ) -> Tuple[Points, List[Dict[str, Any]]]: ...
-def map_scene(scene: Scene, segments: Optional[int] = None, allow_large: bool = False) -> Dict[str, Any]: ...
+def map_scene(
+    scene: Scene,
+    segments: Optional[int] = None,
+    progress: Optional[Callable[[Dict[str, Any]], Any]] = None,
+    cache: Optional[str] = None,
+    allow_large: bool = False,
+) -> Dict[str, Any]: ...
 def verify(
     path: str,
     scene: Optional[str] = None,

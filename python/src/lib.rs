@@ -15,11 +15,13 @@ use knotrod::analysis::equilibrium::Equilibrium;
 use knotrod::analysis::event::Event;
 use knotrod::analysis::profile::Profile;
 use knotrod::geometry::closure::{extent, ray_closure};
+use knotrod::io::map_files::{LineFolder, trace_cached};
 use knotrod::io::recording::{Recorder, parse_recording, parse_state};
 use knotrod::io::verify_file::read_solutions;
 use knotrod::model::rod::{Parameter, RodModel};
 use knotrod::scene::{Job, Scene, SceneError as LibSceneError};
-use knotrod::study::error::StudyError;
+use knotrod::study::boundary::{Traced, trace_island};
+use knotrod::study::error::{StudyError, describe};
 use knotrod::study::map::{Line, LineStore};
 use knotrod::study::verify::{SolutionCheck, VerifyOptions, verify_all};
 use knotrod::{knot_type as lib_knot_type, writhe_closed};
@@ -31,6 +33,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
+use std::sync::Mutex;
 
 pyo3::create_exception!(
     _knotrod,
@@ -573,27 +576,82 @@ fn run<'py>(
     Ok((points, events))
 }
 
-/// Lines kept in memory only: a map from Python does not resume.
-struct NoStore;
+/// Where a map from Python keeps its lines (a folder, to resume, or memory
+/// only), and its window on Python: every line computed is handed to
+/// `progress` after Python's signal handlers ran; an exception there (Ctrl-C's
+/// KeyboardInterrupt) stops the map after the lines in progress.
+struct PyLines<'a> {
+    folder: Option<LineFolder>,
+    progress: Option<&'a Py<PyAny>>,
+    parameter: &'a str,
+    done: Mutex<Vec<Line>>,
+    python: Mutex<Option<PyErr>>,
+}
 
-impl LineStore for NoStore {
-    fn get(&self, _index: usize, _value: f64) -> Option<Line> {
-        None
+impl PyLines<'_> {
+    /// Run Python's signal handlers and the progress callback with `item`;
+    /// an exception is kept, and reported as an interruption.
+    fn tell(&self, item: impl FnOnce(&Bound<'_, PyDict>) -> PyResult<()>) -> Result<(), String> {
+        let python = Python::attach(|py| -> PyResult<()> {
+            py.check_signals()?;
+            if let Some(cb) = self.progress {
+                let d = PyDict::new(py);
+                item(&d)?;
+                cb.call1(py, (d,))?;
+            }
+            Ok(())
+        });
+        python.map_err(|e| {
+            let mut kept = self.python.lock().unwrap_or_else(|p| p.into_inner());
+            kept.get_or_insert(e);
+            INTERRUPTED.to_string()
+        })
     }
-    fn put(&self, _line: &Line) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+}
+
+impl LineStore for PyLines<'_> {
+    fn get(&self, index: usize, value: f64) -> Option<Line> {
+        let line = self.folder.as_ref()?.get(index, value)?;
+        self.done
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .push(line.clone());
+        Some(line)
+    }
+    fn put(&self, line: &Line) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+        if let Some(f) = &self.folder {
+            f.put(line)?;
+        }
+        self.done
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .push(line.clone());
+        self.tell(|d| {
+            d.set_item("stage", "line")?;
+            d.set_item("index", line.index)?;
+            d.set_item(self.parameter, line.value)?;
+            d.set_item("good_intervals", line.intervals.len())
+        })?;
         Ok(())
     }
 }
 
-/// Map a scene's good-knot region (its `[map]` and `[continuation]`): the
-/// assembled map as a dict (lines, intervals, grid, area), without the
-/// boundary walk.
+/// Map a scene's good-knot region (its `[map]` and `[continuation]`), as
+/// `knotrod map` does: the boundary walk from the scene's good knot (its
+/// boundary polished on the continuum when `[map] polish = true`), then one
+/// branch per line in parallel; the assembled map as a dict. `progress` gets
+/// a dict per boundary point and per line; `cache` names a folder keeping
+/// the lines and the walk, from which a rerun resumes. Ctrl-C stops it
+/// (after the walk or the lines in progress) with a KeyboardInterrupt whose
+/// `partial` holds the walk and the lines computed.
 #[pyfunction]
-#[pyo3(signature = (scene, segments=None, allow_large=false))]
+#[pyo3(signature = (scene, segments=None, progress=None, cache=None, allow_large=false))]
 fn map_scene<'py>(
     py: Python<'py>,
     scene: &PyScene,
     segments: Option<usize>,
+    progress: Option<Py<PyAny>>,
+    cache: Option<PathBuf>,
     allow_large: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     check_segments(segments)?;
@@ -608,11 +666,77 @@ fn map_scene<'py>(
     let name = s.file_stem("map");
     let indices: Vec<usize> = (0..spec.lines).collect();
     let model = s.rod_model(segments);
-    let lines = detached(py, || {
-        knotrod::study::map::compute_lines(s, &spec, &indices, segments, &NoStore, &|_| {})
+    let folder = match &cache {
+        Some(c) => Some(
+            LineFolder::create(c, s, &spec, segments)
+                .map_err(|e| KnotrodError::new_err(e.to_string()))?,
+        ),
+        None => None,
+    };
+    let store = PyLines {
+        folder,
+        progress: progress.as_ref(),
+        parameter: spec.parameter.name(),
+        done: Mutex::new(Vec::new()),
+        python: Mutex::new(None),
+    };
+    // the walk first (sequential), as the CLI: its points reported, an
+    // interruption honoured when it ends
+    let on_point = |k: usize, on: &str| {
+        let _ = store.tell(|d| {
+            d.set_item("stage", "boundary")?;
+            d.set_item("point", k)?;
+            d.set_item("on", on)
+        });
+    };
+    // a walk that cannot start or fails says why in the map (`stopped`),
+    // as the CLI's
+    let traced = detached(py, || match &cache {
+        Some(c) => trace_cached(s, &spec, segments, c, &on_point).map_err(|e| e.to_string()),
+        None => Ok(trace_island(s, &spec, segments, &on_point)
+            .unwrap_or_else(|e| Traced::failed(describe(&e)))),
     })?
-    .map_err(|e| study_error(py, &e, None, &model))?;
-    let map = knotrod::study::map::assemble(&name, &spec, cont.parameter, cont.range, lines, None);
+    .map_err(|e| KnotrodError::new_err(format!("the boundary walk's cache: {e}")))?;
+    let interrupted = |py: Python<'py>, store: PyLines, traced: &Traced| {
+        let err = store
+            .python
+            .into_inner()
+            .unwrap_or_else(|p| p.into_inner())?;
+        let lines = store.done.into_inner().unwrap_or_else(|p| p.into_inner());
+        let partial = PyDict::new(py);
+        let _ = to_py(py, traced).and_then(|t| partial.set_item("traced", t));
+        let _ = to_py(py, &lines).and_then(|l| partial.set_item("lines", l));
+        let _ = err.value(py).setattr("partial", partial);
+        Some(err)
+    };
+    let kept_error = store
+        .python
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .is_some();
+    if kept_error {
+        return Err(interrupted(py, store, &traced).expect("an exception was kept"));
+    }
+    let lines = detached(py, || {
+        knotrod::study::map::compute_lines(s, &spec, &indices, segments, &store, &|_| {})
+    })?;
+    let lines = match lines {
+        Ok(lines) => lines,
+        Err(e) => {
+            if let Some(err) = interrupted(py, store, &traced) {
+                return Err(err);
+            }
+            return Err(study_error(py, &e, None, &model));
+        }
+    };
+    let map = knotrod::study::map::assemble(
+        &name,
+        &spec,
+        cont.parameter,
+        cont.range,
+        lines,
+        Some(traced),
+    );
     to_py(py, &map)
 }
 

@@ -291,3 +291,46 @@ def test_event_kinds_are_strings_and_an_enum(root):
     assert "wall" in {w.kind} and f"{w.kind:>5}" == " wall" and str(w.kind) == "wall"
     assert json.loads(json.dumps(w.to_dict()))["kind"] == "wall"
     assert knotrod.EventKind("branch_point") is knotrod.EventKind.BRANCH_POINT
+
+
+def island_scene(root):
+    """Figure 7-left at N = 40 with three lines and no polish: a quick map."""
+    text = (root / "scenes/fig7_island_kirchhoff.toml").read_text()
+    for a, b in [("segments = 100", "segments = 40"), ("lines = 27", "lines = 3"),
+                 ("grid_columns = 91", "grid_columns = 11"), ("polish = true", "polish = false")]:
+        assert a in text
+        text = text.replace(a, b)
+    return knotrod.Scene.from_text(text)
+
+
+def test_map_walks_the_island_boundary_and_resumes_from_its_cache(root, tmp_path):
+    seen = []
+    m = knotrod.map(island_scene(root), progress=seen.append, cache=tmp_path)
+    traced = m["traced"]
+    # Figure 7-left: the island is bounded by W1, S, X and W2
+    assert traced["closed"], traced["stopped"]
+    assert sorted(p["label"] for p in traced["pieces"]) == ["S", "W1", "W2", "X"]
+    assert 0.8 < traced["area"] / m["good_area"] < 1.2
+    boundary = [s for s in seen if s["stage"] == "boundary"]
+    lines = [s for s in seen if s["stage"] == "line"]
+    assert len(boundary) > 50
+    assert sorted(s["index"] for s in lines) == [0, 1, 2]
+    # a rerun takes the walk and the lines from the cache
+    again = []
+    assert knotrod.map(island_scene(root), progress=again.append, cache=tmp_path) == m
+    assert again == []
+
+
+def test_an_interrupted_map_keeps_its_walk_and_lines(root):
+    class Stop(Exception):
+        pass
+
+    def progress(item):
+        if item["stage"] == "line":
+            raise Stop()
+
+    with pytest.raises(Stop) as stopped:
+        knotrod.map(island_scene(root), progress=progress)
+    partial = stopped.value.partial
+    assert partial["traced"]["closed"]
+    assert 1 <= len(partial["lines"]) <= 3
