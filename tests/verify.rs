@@ -17,7 +17,7 @@ fn verify(file: &str, fit: Option<Parameter>) -> Vec<SolutionCheck> {
         fit,
         ..VerifyOptions::default()
     };
-    verify_all(&scene, &solutions, &options, &|_| {}).unwrap()
+    verify_all(&scene, &solutions, &options, &|_| Ok(())).unwrap()
 }
 
 fn relative(c: &SolutionCheck, q: Quantity) -> f64 {
@@ -131,7 +131,7 @@ fn results_do_not_depend_on_the_thread_count_or_the_file_format() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| verify_all(&scene, &solutions, &options, &|_| {}).unwrap())
+            .install(|| verify_all(&scene, &solutions, &options, &|_| Ok(())).unwrap())
     };
     let one = serde_json::to_string(&run(1)).unwrap();
     assert_eq!(one, serde_json::to_string(&run(2)).unwrap());
@@ -212,7 +212,7 @@ fn bad_solution_files_name_the_row_and_field() {
     let far = dir.join("far.toml");
     std::fs::write(&far, format!("{head}{good}delta = -1.0\n")).unwrap();
     let (scene, solutions) = read_solutions(&far, None).unwrap();
-    let checks = verify_all(&scene, &solutions, &VerifyOptions::default(), &|_| {}).unwrap();
+    let checks = verify_all(&scene, &solutions, &VerifyOptions::default(), &|_| Ok(())).unwrap();
     match &checks[0].verdict {
         Verdict::Failed(why) => assert!(why.contains("delta"), "{why}"),
         v => panic!("{v:?}"),

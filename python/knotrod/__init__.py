@@ -647,16 +647,22 @@ def verify(
     segments: Sequence[int] = (100, 200, 400),
     stiffness: float = 1e7,
     fit: Optional[str] = None,
+    progress: Optional[Callable[[Dict[str, Any]], Any]] = None,
 ) -> List[Dict[str, Any]]:
     """Verify a table of shooting solutions (TOML ``[[solution]]``, JSON or
     CSV, as ``knotrod verify`` reads) by two independent methods: the
     continuum equations integrated adaptively and polished, and the discrete
     rod at N, 2N, 4N extrapolated. One dict per solution (``verdict``,
-    ``estimates``, ``claims``...)."""
+    ``estimates``, ``claims``...). ``progress`` is called with each
+    solution's dict as it is done; Ctrl-C stops the run once the solutions in
+    progress are done, with a KeyboardInterrupt whose ``partial`` lists
+    those done."""
     n = tuple(int(k) for k in segments)
     if len(n) != 3:
         raise ValueError("segments: three resolutions N, 2N, 4N")
-    return _knotrod.verify(os.fspath(path), None if scene is None else os.fspath(scene), n, float(stiffness), fit)
+    return _knotrod.verify(
+        os.fspath(path), None if scene is None else os.fspath(scene), n, float(stiffness), fit, progress
+    )
 
 
 def knot_type(points: Union[np.ndarray, Iterable[Sequence[float]]], closed: bool = True) -> Dict[str, Any]:

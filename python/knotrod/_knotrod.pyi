@@ -63,6 +63,7 @@ def verify(
     segments: Tuple[int, int, int] = (100, 200, 400),
     stiffness: float = 1e7,
     fit: Optional[str] = None,
+    progress: Optional[Callable[[Dict[str, Any]], Any]] = None,
 ) -> List[Dict[str, Any]]: ...
 def knot_type(points: List[List[float]], closed: bool = True) -> Dict[str, Any]: ...
 def read_recording(

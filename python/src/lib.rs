@@ -742,9 +742,11 @@ fn map_scene<'py>(
 
 /// Verify shooting solutions (a TOML, JSON or CSV file as `knotrod verify`
 /// reads) by the continuum and the discrete rod at N, 2N, 4N: one dict per
-/// solution.
+/// solution. `progress` gets each solution's dict as it is done (in the
+/// order they finish); Ctrl-C stops the run once the solutions in progress
+/// are done, with a KeyboardInterrupt whose `partial` lists those done.
 #[pyfunction]
-#[pyo3(signature = (path, scene=None, segments=(100, 200, 400), stiffness=1e7, fit=None))]
+#[pyo3(signature = (path, scene=None, segments=(100, 200, 400), stiffness=1e7, fit=None, progress=None))]
 fn verify<'py>(
     py: Python<'py>,
     path: PathBuf,
@@ -752,6 +754,7 @@ fn verify<'py>(
     segments: (usize, usize, usize),
     stiffness: f64,
     fit: Option<&str>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (n1, n2, n3) = segments;
     if !(n1 >= 4 && n2 == 2 * n1 && n3 == 2 * n2 && n3 <= 100_000) {
@@ -784,9 +787,35 @@ fn verify<'py>(
         err
     })?;
     let model = base.rod_model(None);
-    let checks: Vec<SolutionCheck> =
-        detached(py, || verify_all(&base, &solutions, &options, &|_| {}))?
-            .map_err(|e| study_error(py, &e, None, &model))?;
+    let done: Mutex<Vec<SolutionCheck>> = Mutex::new(Vec::new());
+    let python: Mutex<Option<PyErr>> = Mutex::new(None);
+    let on_done = |c: &SolutionCheck| -> Result<(), StudyError> {
+        done.lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .push(c.clone());
+        // the GIL for a moment: Python's signal handlers, then the callback
+        Python::attach(|py| -> PyResult<()> {
+            py.check_signals()?;
+            if let Some(cb) = &progress {
+                cb.call1(py, (to_py(py, c)?,))?;
+            }
+            Ok(())
+        })
+        .map_err(|e| {
+            python
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .get_or_insert(e);
+            StudyError::Observer(INTERRUPTED.into())
+        })
+    };
+    let checks = detached(py, || verify_all(&base, &solutions, &options, &on_done))?;
+    if let Some(err) = python.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        let done = done.into_inner().unwrap_or_else(|p| p.into_inner());
+        let _ = to_py(py, &done).and_then(|d| err.value(py).setattr("partial", d));
+        return Err(err);
+    }
+    let checks = checks.map_err(|e| study_error(py, &e, None, &model))?;
     to_py(py, &checks)
 }
 

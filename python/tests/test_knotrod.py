@@ -334,3 +334,21 @@ def test_an_interrupted_map_keeps_its_walk_and_lines(root):
     partial = stopped.value.partial
     assert partial["traced"]["closed"]
     assert 1 <= len(partial["lines"]) <= 3
+
+
+def test_verify_reports_each_solution_and_stops_on_an_exception(root):
+    table = root / "scenes/verify/two_equilibria.toml"
+    seen = []
+    checks = knotrod.verify(table, segments=(20, 40, 80), progress=seen.append)
+    assert sorted(c["index"] for c in seen) == sorted(c["index"] for c in checks)
+    assert len(checks) >= 2
+
+    class Stop(Exception):
+        pass
+
+    def stop(check):
+        raise Stop()
+
+    with pytest.raises(Stop) as stopped:
+        knotrod.verify(table, segments=(20, 40, 80), progress=stop)
+    assert 1 <= len(stopped.value.partial) <= len(checks)

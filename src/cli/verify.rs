@@ -83,6 +83,7 @@ pub fn verify(a: Args) -> Result<()> {
     let run = || {
         verify_all(&base, &solutions, &options, &|c: &SolutionCheck| {
             progress.item(format!("{}: {:?}", c.given.name, c.verdict));
+            Ok(())
         })
     };
     let checks = match a.threads {

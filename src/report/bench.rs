@@ -141,7 +141,7 @@ fn verify_workload(scenes: &Path) -> Result<Workload> {
     )
     .map_err(|e| crate::report::error::ReportError::Failed(e.to_string()))?;
     timed("verify_branch_100", 100, || {
-        let checks = verify_all(&scene, &solutions, &VerifyOptions::default(), &|_| {})?;
+        let checks = verify_all(&scene, &solutions, &VerifyOptions::default(), &|_| Ok(()))?;
         let confirmed = checks
             .iter()
             .filter(|c| c.verdict == Verdict::Confirmed)

@@ -739,14 +739,15 @@ fn fit(
     })
 }
 
-/// Verify all solutions (in parallel), reporting each as it is done; rows of
-/// the same parameters whose polished unknowns differ are marked as different
-/// equilibria.
+/// Verify all solutions (in parallel), reporting each as it is done (an
+/// error from `on_done` stops the run once the solutions in progress are
+/// done, and is returned); rows of the same parameters whose polished
+/// unknowns differ are marked as different equilibria.
 pub fn verify_all(
     base: &Scene,
     solutions: &[Solution],
     options: &VerifyOptions,
-    on_done: &(dyn Fn(&SolutionCheck) + Sync),
+    on_done: &(dyn Fn(&SolutionCheck) -> Result<()> + Sync),
 ) -> Result<Vec<SolutionCheck>> {
     use rayon::prelude::*;
     if options.segments.iter().any(|&n| n < 4) {
@@ -759,10 +760,10 @@ pub fn verify_all(
         .enumerate()
         .map(|(k, s)| {
             let c = verify_solution(base, k, s, options);
-            on_done(&c);
-            c
+            on_done(&c)?;
+            Ok(c)
         })
-        .collect();
+        .collect::<Result<_>>()?;
     for k in 0..checks.len() {
         for j in 0..k {
             let (a, b) = (&checks[j], &checks[k]);
