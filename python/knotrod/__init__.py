@@ -557,19 +557,41 @@ class Recording:
         return f"Recording({len(self.states)} states, {len(self.events)} events)"
 
 
-def equilibrium(scene: SceneLike, segments: Optional[int] = None, allow_large: bool = False) -> Equilibrium:
+StartLike = Union["Equilibrium", str]
+
+
+def _started(scene: SceneLike, start: Optional[StartLike]) -> Any:
+    """The scene, restarted from ``start`` (an :class:`Equilibrium` or its
+    ``state_json``) when given: at the state's N, from its shape."""
+    s = _scene(scene)
+    if start is None:
+        return s
+    return s.with_start(start if isinstance(start, str) else start.state_json)
+
+
+def equilibrium(
+    scene: SceneLike, segments: Optional[int] = None, allow_large: bool = False, start: Optional[StartLike] = None
+) -> Equilibrium:
     """Solve the scene's equilibrium at its clamps (``knotrod run`` of a
     scene without continuation): its start solved by Newton and measured.
 
-    ``segments`` overrides N; ``allow_large`` runs a scene over its budget.
+    ``segments`` overrides N; ``allow_large`` runs a scene over its budget;
+    ``start`` (an equilibrium handed back earlier, or its ``state_json``)
+    replaces the scene's initial shape, at the state's N.
     """
-    return Equilibrium(_knotrod.solve(_scene(scene), segments, allow_large))
+    return Equilibrium(_knotrod.solve(_started(scene, start), segments, allow_large))
 
 
-def _run(scene: SceneLike, segments: Optional[int], progress: Optional[Callable[[Dict[str, Any]], Any]], record: Optional[PathLike], allow_large: bool) -> Branch:
+def _run(
+    scene: Any,
+    segments: Optional[int],
+    progress: Optional[Callable[[Dict[str, Any]], Any]],
+    record: Optional[PathLike],
+    allow_large: bool,
+) -> Branch:
     rec = None if record is None else os.fspath(record)
     try:
-        points, events = _knotrod.run(_scene(scene), segments, progress, rec, allow_large)
+        points, events = _knotrod.run(scene, segments, progress, rec, allow_large)
     except BaseException as e:
         # Ctrl-C, or the progress callback's own exception: what was computed
         partial = getattr(e, "partial", None)
@@ -585,9 +607,11 @@ def branch(
     progress: Optional[Callable[[Dict[str, Any]], Any]] = None,
     record: Optional[PathLike] = None,
     allow_large: bool = False,
+    start: Optional[StartLike] = None,
 ) -> Branch:
     """Follow the scene's branch(es) (its ``[continuation]``, swept over
-    ``[sweep]``): every equilibrium and the labelled events.
+    ``[sweep]``): every equilibrium and the labelled events, from the
+    scene's start or from ``start`` (as for :func:`equilibrium`).
 
     ``progress(point)`` is called with a dict (index, branch, z_star, delta,
     phi_over_2pi, twist, stable, good_knot) after each equilibrium; an
@@ -596,7 +620,7 @@ def branch(
     the current equilibrium: the ``KeyboardInterrupt`` has ``partial`` (the
     :class:`Branch` so far) and ``recording``.
     """
-    return _run(scene, segments, progress, record, allow_large)
+    return _run(_started(scene, start), segments, progress, record, allow_large)
 
 
 def loading(
@@ -605,11 +629,12 @@ def loading(
     progress: Optional[Callable[[Dict[str, Any]], Any]] = None,
     record: Optional[PathLike] = None,
     allow_large: bool = False,
+    start: Optional[StartLike] = None,
 ) -> Branch:
     """Follow the scene's quasi-static loading path (its ``[[loading]]``
     legs): each step minimised from the previous equilibrium, jumps and
     other events located. Arguments as for :func:`branch`."""
-    s = _scene(scene)
+    s = _started(scene, start)
     if not json.loads(s.to_json()).get("loading"):
         err = SceneError("the scene has no [[loading]] legs")
         err.field = "loading"

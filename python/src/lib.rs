@@ -19,7 +19,7 @@ use knotrod::io::map_files::{LineFolder, trace_cached};
 use knotrod::io::recording::{Recorder, parse_recording, parse_state};
 use knotrod::io::verify_file::read_solutions;
 use knotrod::model::rod::{Parameter, RodModel};
-use knotrod::scene::{Job, Scene, SceneError as LibSceneError};
+use knotrod::scene::{InitialShape, Job, Scene, SceneError as LibSceneError};
 use knotrod::study::boundary::{Traced, trace_island};
 use knotrod::study::error::{StudyError, describe};
 use knotrod::study::map::{Line, LineStore};
@@ -80,6 +80,29 @@ impl PyScene {
     #[staticmethod]
     fn from_text(text: String) -> PyResult<Self> {
         let scene = Scene::parse(&text).map_err(|e| scene_error(&e, Some(&text)))?;
+        Ok(PyScene { scene, text })
+    }
+
+    /// The scene restarted from a state (an equilibrium's `state_json`):
+    /// `[initial] shape = "file"` with that state, at its N. Its text says so
+    /// in a comment; the state itself is not in it.
+    fn with_start(&self, state_json: &str) -> PyResult<Self> {
+        let state: knotrod::RodState = serde_json::from_str(state_json).map_err(|e| {
+            let err = SceneError::new_err(format!("start: not a rod state: {e}"));
+            Python::attach(|py| {
+                let _ = err.value(py).setattr("field", "initial.file");
+            });
+            err
+        })?;
+        let mut scene = self.scene.clone();
+        scene.model.segments = state.segments() as i64;
+        scene.initial.shape = InitialShape::File;
+        scene.initial.from_recording = None;
+        scene.initial.state = Some(state);
+        let text = format!(
+            "{}\n# started from a state handed over in Python (N = {}), not in this text\n",
+            self.text, scene.model.segments
+        );
         Ok(PyScene { scene, text })
     }
 

@@ -352,3 +352,29 @@ def test_verify_reports_each_solution_and_stops_on_an_exception(root):
     with pytest.raises(Stop) as stopped:
         knotrod.verify(table, segments=(20, 40, 80), progress=stop)
     assert 1 <= len(stopped.value.partial) <= len(checks)
+
+
+def test_a_branch_restarts_from_an_equilibrium_handed_back(root):
+    first = knotrod.branch(root / "scenes/fig3_kirchhoff.toml", segments=40)
+    w1 = first.event("W1")
+    # an equilibrium of W1's branch a little away from it, at its clamps,
+    # restarts a solve and a branch
+    near = min(
+        (p for p in first.points if p.branch == w1.branch),
+        key=lambda p: abs(p.phi_over_2pi - w1.phi_over_2pi - 0.02),
+    )
+    text = (root / "scenes/fig3_kirchhoff.toml").read_text().replace(
+        "phi_over_2pi = 0.802", f"phi_over_2pi = {near.phi_over_2pi!r}"
+    )
+    scene = knotrod.Scene.from_text(text)
+    again = knotrod.equilibrium(scene, start=near)
+    assert again.segments == 40
+    np.testing.assert_allclose(again.nodes, near.nodes, atol=1e-7)
+    assert relative(again.twist, near.twist) < 1e-8
+    restarted = knotrod.branch(scene, start=near)
+    # the same wall, whatever the labels of a branch from another start
+    walls = [e.phi_over_2pi for e in restarted.events if e.kind == "wall"]
+    assert min(abs(p - w1.phi_over_2pi) for p in walls) < 1e-6
+    with pytest.raises(knotrod.SceneError) as bad:
+        knotrod.equilibrium(scene, start="{}")
+    assert bad.value.field == "initial.file"
