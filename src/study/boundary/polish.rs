@@ -509,7 +509,7 @@ fn pieces_by_critical_point(
 ) -> Vec<usize> {
     let mut piece_of: Vec<usize> = jobs.iter().map(|j| j.0).collect();
     // the start of the longest tail of `s` (from its second entry on) whose
-    // entries are all nearer `other` than the entry before the tail
+    // entries are all NEARER times nearer `other` than the entry before it
     let tail = |s: &[[f64; 2]], other: &[f64; 2]| -> usize {
         (1..s.len())
             .find(|&cut| {
