@@ -484,9 +484,6 @@ struct RunOutcome {
     events: Vec<Event>,
     /// Why it stopped early.
     error: Option<StudyError>,
-    /// The Python exception raised in the observer (Ctrl-C, or the
-    /// progress callback's own).
-    python: Option<PyErr>,
 }
 
 /// Run a scene (a branch, a sweep of branches or a loading path): every
@@ -517,12 +514,12 @@ fn run<'py>(
         ),
         None => None,
     };
+    let window = Window::new(progress.as_ref());
     let outcome = detached(py, || {
         let mut out = RunOutcome {
             equilibria: Vec::new(),
             events: Vec::new(),
             error: None,
-            python: None,
         };
         let mut record_error = None;
         let result = knotrod::run_scene(s, segments, &mut |eq: Equilibrium| {
@@ -531,33 +528,24 @@ fn run<'py>(
             {
                 record_error = Some(e.to_string());
             }
-            // the GIL for a moment: run Python's signal handlers (Ctrl-C
-            // raises KeyboardInterrupt here) and the progress callback
-            let python = Python::attach(|py| -> PyResult<()> {
-                py.check_signals()?;
-                if let Some(cb) = &progress {
-                    let d = PyDict::new(py);
-                    d.set_item("index", out.equilibria.len())?;
+            let index = out.equilibria.len();
+            let told = window.tell(|py| {
+                item(py, |d| {
+                    d.set_item("index", index)?;
                     d.set_item("branch", eq.branch)?;
                     d.set_item("z_star", eq.z_star)?;
                     d.set_item("delta", eq.delta)?;
                     d.set_item("phi_over_2pi", eq.phi_over_2pi)?;
                     d.set_item("twist", eq.twist)?;
                     d.set_item("stable", eq.stable)?;
-                    d.set_item("good_knot", eq.good_knot)?;
-                    cb.call1(py, (d,))?;
-                }
-                Ok(())
+                    d.set_item("good_knot", eq.good_knot)
+                })
             });
             out.equilibria.push(eq);
             if let Some(e) = record_error.take() {
                 return Err(StudyError::Observer(format!("recording: {e}").into()));
             }
-            if let Err(e) = python {
-                out.python = Some(e);
-                return Err(StudyError::Observer(INTERRUPTED.into()));
-            }
-            Ok(())
+            told
         });
         match result {
             Ok(events) => out.events = events,
@@ -577,8 +565,10 @@ fn run<'py>(
         equilibria,
         events,
         error,
-        python,
     } = outcome;
+    // the Python exception raised in the observer (Ctrl-C, or the progress
+    // callback's own)
+    let python = window.raised();
     // the equilibria stay Rust values; Python converts those it reads
     let error = match (&python, &error) {
         (None, Some(e)) => Some(study_error(py, e, equilibria.last(), &model)),
@@ -599,61 +589,96 @@ fn run<'py>(
     Ok((points, events))
 }
 
-/// Where a map from Python keeps its lines (a folder, to resume, or memory
-/// only), and its window on Python: every line computed is handed to
-/// `progress` after Python's signal handlers ran; an exception there (Ctrl-C's
-/// KeyboardInterrupt) stops the map after the lines in progress.
-struct PyLines<'a> {
-    folder: Option<LineFolder>,
-    progress: Option<&'a Py<PyAny>>,
-    parameter: &'a str,
-    done: Mutex<Vec<Line>>,
-    python: Mutex<Option<PyErr>>,
+/// The value in a mutex, also after a panic elsewhere poisoned it.
+fn locked<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-impl PyLines<'_> {
-    /// Run Python's signal handlers and the progress callback with `item`;
-    /// an exception is kept, and reported as an interruption.
-    fn tell(&self, item: impl FnOnce(&Bound<'_, PyDict>) -> PyResult<()>) -> Result<(), String> {
-        let python = Python::attach(|py| -> PyResult<()> {
+/// Python's window on a long call made without the GIL: each report takes
+/// the GIL for a moment, runs Python's signal handlers (Ctrl-C raises
+/// KeyboardInterrupt there) and the progress callback; the first exception
+/// is kept and the call told to stop.
+struct Window<'a> {
+    progress: Option<&'a Py<PyAny>>,
+    raised: Mutex<Option<PyErr>>,
+}
+
+impl<'a> Window<'a> {
+    fn new(progress: Option<&'a Py<PyAny>>) -> Self {
+        Window {
+            progress,
+            raised: Mutex::new(None),
+        }
+    }
+
+    /// Report: the callback gets `item`'s object (built only when there is a
+    /// callback); an error once Python raised.
+    fn tell(
+        &self,
+        item: impl FnOnce(Python<'_>) -> PyResult<Bound<'_, PyAny>>,
+    ) -> Result<(), StudyError> {
+        Python::attach(|py| -> PyResult<()> {
             py.check_signals()?;
             if let Some(cb) = self.progress {
-                let d = PyDict::new(py);
-                item(&d)?;
-                cb.call1(py, (d,))?;
+                cb.call1(py, (item(py)?,))?;
             }
             Ok(())
-        });
-        python.map_err(|e| {
-            let mut kept = self.python.lock().unwrap_or_else(|p| p.into_inner());
-            kept.get_or_insert(e);
-            INTERRUPTED.to_string()
+        })
+        .map_err(|e| {
+            locked(&self.raised).get_or_insert(e);
+            StudyError::Observer(INTERRUPTED.into())
         })
     }
+
+    /// Whether Python raised.
+    fn has_raised(&self) -> bool {
+        locked(&self.raised).is_some()
+    }
+
+    /// The exception Python raised, if it did.
+    fn raised(self) -> Option<PyErr> {
+        self.raised.into_inner().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+/// A dict built by `fill`, as a progress item.
+fn item<'py>(
+    py: Python<'py>,
+    fill: impl FnOnce(&Bound<'py, PyDict>) -> PyResult<()>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let d = PyDict::new(py);
+    fill(&d)?;
+    Ok(d.into_any())
+}
+
+/// Where a map from Python keeps its lines (a folder, to resume, or memory
+/// only): every line computed is reported through the window, whose
+/// exception (Ctrl-C) stops the map after the lines in progress.
+struct PyLines<'a> {
+    folder: Option<LineFolder>,
+    window: &'a Window<'a>,
+    parameter: &'a str,
+    done: Mutex<Vec<Line>>,
 }
 
 impl LineStore for PyLines<'_> {
     fn get(&self, index: usize, value: f64) -> Option<Line> {
         let line = self.folder.as_ref()?.get(index, value)?;
-        self.done
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .push(line.clone());
+        locked(&self.done).push(line.clone());
         Some(line)
     }
     fn put(&self, line: &Line) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
         if let Some(f) = &self.folder {
             f.put(line)?;
         }
-        self.done
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .push(line.clone());
-        self.tell(|d| {
-            d.set_item("stage", "line")?;
-            d.set_item("index", line.index)?;
-            d.set_item(self.parameter, line.value)?;
-            d.set_item("good_intervals", line.intervals.len())
+        locked(&self.done).push(line.clone());
+        self.window.tell(|py| {
+            item(py, |d| {
+                d.set_item("stage", "line")?;
+                d.set_item("index", line.index)?;
+                d.set_item(self.parameter, line.value)?;
+                d.set_item("good_intervals", line.intervals.len())
+            })
         })?;
         Ok(())
     }
@@ -696,20 +721,22 @@ fn map_scene<'py>(
         ),
         None => None,
     };
+    let window = Window::new(progress.as_ref());
     let store = PyLines {
         folder,
-        progress: progress.as_ref(),
+        window: &window,
         parameter: spec.parameter.name(),
         done: Mutex::new(Vec::new()),
-        python: Mutex::new(None),
     };
     // the walk first (sequential), as the CLI: its points reported, an
     // interruption honoured when it ends
     let on_point = |k: usize, on: &str| {
-        let _ = store.tell(|d| {
-            d.set_item("stage", "boundary")?;
-            d.set_item("point", k)?;
-            d.set_item("on", on)
+        let _ = window.tell(|py| {
+            item(py, |d| {
+                d.set_item("stage", "boundary")?;
+                d.set_item("point", k)?;
+                d.set_item("on", on)
+            })
         });
     };
     // a walk that cannot start or fails says why in the map (`stopped`),
@@ -720,38 +747,25 @@ fn map_scene<'py>(
             .unwrap_or_else(|e| Traced::failed(describe(&e)))),
     })?
     .map_err(|e| KnotrodError::new_err(format!("the boundary walk's cache: {e}")))?;
-    let interrupted = |py: Python<'py>, store: PyLines, traced: &Traced| {
-        let err = store
-            .python
-            .into_inner()
-            .unwrap_or_else(|p| p.into_inner())?;
-        let lines = store.done.into_inner().unwrap_or_else(|p| p.into_inner());
+    let lines = if window.has_raised() {
+        None
+    } else {
+        Some(detached(py, || {
+            knotrod::study::map::compute_lines(s, &spec, &indices, segments, &store, &|_| {})
+        })?)
+    };
+    // an exception in Python (Ctrl-C): the walk and the lines done kept
+    let done = store.done.into_inner().unwrap_or_else(|p| p.into_inner());
+    if let Some(err) = window.raised() {
         let partial = PyDict::new(py);
-        let _ = to_py(py, traced).and_then(|t| partial.set_item("traced", t));
-        let _ = to_py(py, &lines).and_then(|l| partial.set_item("lines", l));
+        let _ = to_py(py, &traced).and_then(|t| partial.set_item("traced", t));
+        let _ = to_py(py, &done).and_then(|l| partial.set_item("lines", l));
         let _ = err.value(py).setattr("partial", partial);
-        Some(err)
-    };
-    let kept_error = store
-        .python
-        .lock()
-        .unwrap_or_else(|p| p.into_inner())
-        .is_some();
-    if kept_error {
-        return Err(interrupted(py, store, &traced).expect("an exception was kept"));
+        return Err(err);
     }
-    let lines = detached(py, || {
-        knotrod::study::map::compute_lines(s, &spec, &indices, segments, &store, &|_| {})
-    })?;
-    let lines = match lines {
-        Ok(lines) => lines,
-        Err(e) => {
-            if let Some(err) = interrupted(py, store, &traced) {
-                return Err(err);
-            }
-            return Err(study_error(py, &e, None, &model));
-        }
-    };
+    let lines = lines
+        .expect("the lines ran: Python raised nothing")
+        .map_err(|e| study_error(py, &e, None, &model))?;
     let map = knotrod::study::map::assemble(
         &name,
         &spec,
@@ -811,29 +825,13 @@ fn verify<'py>(
     })?;
     let model = base.rod_model(None);
     let done: Mutex<Vec<SolutionCheck>> = Mutex::new(Vec::new());
-    let python: Mutex<Option<PyErr>> = Mutex::new(None);
+    let window = Window::new(progress.as_ref());
     let on_done = |c: &SolutionCheck| -> Result<(), StudyError> {
-        done.lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .push(c.clone());
-        // the GIL for a moment: Python's signal handlers, then the callback
-        Python::attach(|py| -> PyResult<()> {
-            py.check_signals()?;
-            if let Some(cb) = &progress {
-                cb.call1(py, (to_py(py, c)?,))?;
-            }
-            Ok(())
-        })
-        .map_err(|e| {
-            python
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .get_or_insert(e);
-            StudyError::Observer(INTERRUPTED.into())
-        })
+        locked(&done).push(c.clone());
+        window.tell(|py| to_py(py, c))
     };
     let checks = detached(py, || verify_all(&base, &solutions, &options, &on_done))?;
-    if let Some(err) = python.into_inner().unwrap_or_else(|p| p.into_inner()) {
+    if let Some(err) = window.raised() {
         let done = done.into_inner().unwrap_or_else(|p| p.into_inner());
         let _ = to_py(py, &done).and_then(|d| err.value(py).setattr("partial", d));
         return Err(err);
