@@ -419,7 +419,7 @@ impl Plane<'_> {
         tb = t;
         let mut visited = vec![pa.at[held], pb.at[held]];
         let why = loop {
-            if visited.len() > 42 {
+            if visited.len() > CORNER_ITERATIONS {
                 break "did not converge".to_string();
             }
             if gb == ga || !gb.is_finite() {
@@ -461,6 +461,9 @@ impl Plane<'_> {
 
 /// Passes retrying failed boundary points from their polished neighbours.
 const RETRY_PASSES: usize = 3;
+
+/// Secant iterates a corner may take.
+const CORNER_ITERATIONS: usize = 42;
 
 /// The iterates of a stalled corner secant whose spread is its error.
 const STALLED_ITERATES: usize = 4;
@@ -617,6 +620,7 @@ pub(super) fn polish_boundary(
     // continuum at small N) is tried again from its piece's nearest polished
     // point, on its own line; passes repeat while they rescue points
     let mut retried = first;
+    let mut from_neighbour: Vec<Option<String>> = vec![None; jobs.len()];
     for _ in 0..RETRY_PASSES {
         let again: Vec<(usize, Result<Polished, String>)> = (0..jobs.len())
             .into_par_iter()
@@ -640,21 +644,21 @@ pub(super) fn polish_boundary(
             .collect();
         let mut rescued = 0;
         for (n, r) in again {
-            match (r, &mut retried[n]) {
-                (Ok(p), slot) => {
-                    *slot = Ok(p);
+            match r {
+                Ok(p) => {
+                    retried[n] = Ok(p);
                     rescued += 1;
                 }
-                (Err(e), Err(first)) => {
-                    if !first.contains("from its piece's nearest") {
-                        *first = format!("{first}; from its piece's nearest polished point: {e}");
-                    }
-                }
-                (Err(_), Ok(_)) => {}
+                Err(e) => from_neighbour[n] = Some(e),
             }
         }
         if rescued == 0 {
             break;
+        }
+    }
+    for (r, e) in retried.iter_mut().zip(from_neighbour) {
+        if let (Err(first), Some(e)) = (r, e) {
+            *first = format!("{first}; from its piece's nearest polished point: {e}");
         }
     }
     // a point that fails (its discrete start too far from the continuum,
@@ -826,24 +830,22 @@ pub(super) fn polish_boundary(
         }
         // the discrete curve's direction at the piece's ends, from the walk
         // points that stay on it
-        let mine: Vec<[f64; 2]> = piece_of
+        // (else the whole discrete piece's; with fewer than two points
+        // nothing is trimmed)
+        let mut mine: Vec<[f64; 2]> = piece_of
             .iter()
             .zip(&jobs)
             .filter(|(p, _)| **p == k)
             .map(|(_, &(kk, i))| trail[kk].1[i].at)
             .collect();
-        let ends = if mine.len() >= 2 {
-            [
-                [mine[0], mine[1]],
-                [mine[mine.len() - 2], mine[mine.len() - 1]],
-            ]
-        } else {
-            [
-                [pts[0].at, pts[1.min(pts.len() - 1)].at],
-                [pts[pts.len().saturating_sub(2)].at, pts[pts.len() - 1].at],
-            ]
-        };
-        trim_past_corners(&mut piece, ends, k > 0, k + 1 < trail.len());
+        if mine.len() < 2 {
+            mine = pts.iter().map(|p| p.at).collect();
+        }
+        let n = mine.len();
+        if n >= 2 {
+            let ends = [[mine[0], mine[1]], [mine[n - 2], mine[n - 1]]];
+            trim_past_corners(&mut piece, ends, k > 0, k + 1 < trail.len());
+        }
         pieces.push(piece);
     }
     // gaps wider than the walk's step (where the polish moved a corner
