@@ -10,7 +10,7 @@ use crate::linalg::sparse::Ldlt;
 use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::solve::kkt::Kkt;
 use crate::solve::minimizer::Minimizer;
-use crate::solve::outcome::{SolveError, residual};
+use crate::solve::outcome::{FloorProbe, SolveError, floor_bound, judge};
 use crate::solve::step::StepControl;
 use serde::{Deserialize, Serialize};
 
@@ -118,6 +118,8 @@ pub struct Tracer<'a> {
     kkt: Option<Kkt>,
     /// Constraint rows of the last linearisation (allocation reused).
     rows: Vec<(f64, [f64; 11])>,
+    /// Scratch of the measured round-off floor.
+    floor: FloorProbe,
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -147,6 +149,7 @@ impl<'a> Tracer<'a> {
             dofs: n,
             kkt,
             rows: Vec::new(),
+            floor: FloorProbe::default(),
         }
     }
 
@@ -188,7 +191,8 @@ impl<'a> Tracer<'a> {
     }
 
     /// Evaluate gradient, Hessian, ∂_p∇E at `state` and factor H. Returns the
-    /// relative gradient and the round-off floor test.
+    /// relative gradient and whether the one convergence test
+    /// ([`judge`]) holds.
     fn linearise(&mut self, state: &RodState) -> Result<(f64, bool), ContinuationError> {
         let energy = &self.newton.energy;
         let n = self.dofs;
@@ -214,7 +218,12 @@ impl<'a> Tracer<'a> {
             return Err(ContinuationError::NonFinite("gradient/Hessian"));
         }
         let max_diag = energy.pattern.max_abs_diagonal(&self.values);
-        let (rel, at_floor) = residual(&info, gnorm, max_diag, state, n);
+        let bound = floor_bound(&info, max_diag, state, n);
+        let floor = &mut self.floor;
+        let judgement = judge(&info, gnorm, self.settings.tolerance, bound, || {
+            floor.measure(energy, state)
+        });
+        let (rel, converged) = (judgement.rel, judgement.converged);
         crate::linalg::counters::set_residual(rel);
         let factored = match &mut self.kkt {
             Some(k) => k.ldlt.factor(&k.values),
@@ -224,7 +233,7 @@ impl<'a> Tracer<'a> {
         if infeasibility > crate::solve::sqp::CURVATURE_TOL {
             return Ok((rel.max(infeasibility), false));
         }
-        Ok((rel, at_floor))
+        Ok((rel, converged))
     }
 
     /// Tangent at a converged state (factorisation of `linearise` in place):
@@ -334,11 +343,9 @@ impl<'a> Tracer<'a> {
         for it in 0..=self.settings.max_corrector_iterations {
             crate::linalg::counters::NEWTON_ITERATIONS
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let (rel, at_floor) = self.linearise(&state)?;
+            let (rel, converged) = self.linearise(&state)?;
             let c = self.weight * self.dot_q(&tq, &offset) + tp * (p - p_pred);
-            if (rel <= self.settings.tolerance || at_floor)
-                && c.abs() <= 1e-10 * sigma.abs().max(1e-12)
-            {
+            if converged && c.abs() <= 1e-10 * sigma.abs().max(1e-12) {
                 let correction =
                     (self.weight * self.dot_q(&offset, &offset) + (p - p_pred).powi(2)).sqrt()
                         / sigma.abs().max(1e-300);
@@ -399,8 +406,8 @@ impl<'a> Tracer<'a> {
         for it in 0..=self.settings.max_corrector_iterations {
             crate::linalg::counters::NEWTON_ITERATIONS
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let (rel, at_floor) = self.linearise(&state)?;
-            if it > 0 && (rel <= self.settings.tolerance || at_floor) {
+            let (rel, converged) = self.linearise(&state)?;
+            if it > 0 && converged {
                 return Ok(self.point_at(state, it, rel, None, 0.0));
             }
             if it == self.settings.max_corrector_iterations {

@@ -6,7 +6,10 @@ use crate::linalg::eigen::lowest_eigenvalues;
 use crate::linalg::sparse::Ldlt;
 use crate::model::energy::{GradientInfo, RodEnergy};
 use crate::model::rod::RodState;
-use crate::solve::outcome::{SolveError, SolveReport, SolverSettings, armijo, residual, stalled};
+use crate::solve::outcome::{
+    FloorProbe, Judgement, SolveError, SolveReport, SolverSettings, Stall, armijo, floor_bound,
+    judge,
+};
 
 /// Work vectors of Newton's method on one energy's pattern (allocated once,
 /// reused by every iteration and solve).
@@ -15,6 +18,7 @@ pub struct Newton {
     values: Vec<f64>,
     step: Vec<f64>,
     trial_step: Vec<f64>,
+    floor: FloorProbe,
 }
 
 impl Newton {
@@ -27,6 +31,7 @@ impl Newton {
             values: vec![0.0; nnz],
             step: vec![0.0; n],
             trial_step: vec![0.0; n],
+            floor: FloorProbe::default(),
         }
     }
 
@@ -59,15 +64,15 @@ impl Newton {
         energy.pattern.max_abs_diagonal(&self.values)
     }
 
-    /// Gradient and Hessian at `state` (into the workspace), the relative
-    /// gradient, and whether the gradient is at its round-off floor (ε ×
-    /// largest stiffness × extent × √n: no step can improve it below that).
+    /// Gradient and Hessian at `state` (into the workspace) and the one
+    /// convergence test ([`judge`]) of the iterate against `tol`.
     fn linearise(
         &mut self,
         energy: &RodEnergy,
         state: &RodState,
         iteration: usize,
-    ) -> Result<(GradientInfo, f64, bool), SolveError> {
+        tol: f64,
+    ) -> Result<(GradientInfo, Judgement), SolveError> {
         crate::linalg::counters::NEWTON_ITERATIONS
             .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let info = energy.hessian(state, &mut self.grad, &mut self.values);
@@ -78,16 +83,11 @@ impl Newton {
                 iteration,
             });
         }
-        let max_diagonal = self.max_diagonal(energy);
-        let (rel, at_floor) = residual(&info, gnorm, max_diagonal, state, self.grad.len());
-        crate::linalg::counters::set_residual(rel);
-        if stalled(gnorm, rel, max_diagonal, state, self.grad.len()) {
-            return Err(SolveError::RoundOff {
-                iteration,
-                residual: rel,
-            });
-        }
-        Ok((info, rel, at_floor))
+        let bound = floor_bound(&info, self.max_diagonal(energy), state, self.grad.len());
+        let floor = &mut self.floor;
+        let judgement = judge(&info, gnorm, tol, bound, || floor.measure(energy, state));
+        crate::linalg::counters::set_residual(judgement.rel);
+        Ok((info, judgement))
     }
 
     /// Newton's method on ∇E = 0 from `state` without line search or shift:
@@ -103,13 +103,15 @@ impl Newton {
         let mut report = SolveReport::start();
         let map = energy.map;
         let mut next = state.clone();
+        let mut stall = Stall::default();
         for it in 0..=settings.max_iterations {
-            let (info, rel, at_floor) = self.linearise(energy, state, it)?;
-            report.record(it, rel, info.energy);
-            if rel <= settings.gradient_tol || at_floor {
+            let (info, judgement) = self.linearise(energy, state, it, settings.gradient_tol)?;
+            report.record(it, judgement.rel, info.energy);
+            if judgement.converged {
                 report.converged = true;
                 return Ok(report);
             }
+            stall.check(it, &judgement)?;
             report.factorizations += 1;
             if ldlt.factor(&self.values).is_err() {
                 return Err(SolveError::NonFinite {
@@ -218,13 +220,16 @@ impl Newton {
         let mut shift = 0.0f64;
         let mut next_shift = 0.0f64;
         let mut trial = state.clone();
+        let mut stall = Stall::default();
         for it in 0..=settings.max_iterations {
-            let (info, rel, at_floor) = self.linearise(energy, state, it)?;
+            let (info, judgement) = self.linearise(energy, state, it, settings.gradient_tol)?;
+            let rel = judgement.rel;
             report.record(it, rel, info.energy);
-            if rel <= settings.gradient_tol || at_floor {
+            if judgement.converged {
                 report.converged = true;
                 return Ok(report);
             }
+            stall.check(it, &judgement)?;
             if it == settings.max_iterations {
                 break;
             }

@@ -2,7 +2,7 @@
 //! Armijo line search and the relative residual test.
 
 use crate::model::contact::{ContactForce, Gap};
-use crate::model::energy::GradientInfo;
+use crate::model::energy::{GradientInfo, RodEnergy};
 use crate::model::rod::RodState;
 use serde::{Deserialize, Serialize};
 
@@ -106,18 +106,22 @@ pub enum SolveError {
         /// At which iteration.
         iteration: usize,
     },
-    /// The gradient reached its round-off floor far from an equilibrium.
+    /// The gradient stopped decreasing above its measured round-off floor.
     #[error(
-        "the gradient reached its round-off floor at Newton iteration {iteration} with the \
-         relative gradient still {residual:.3e} (> 1e-6): this N and stiffness are past what \
-         f64 resolves (stiffness ratio × N² ≳ 1e15); use fewer segments or a smaller \
-         stretching stiffness (larger model.rod_diameter)"
+        "the gradient stalled above its measured round-off floor from Newton iteration \
+         {iteration} on (‖∇E‖ {gradient:.3e}, floor {floor:.3e}, relative gradient \
+         {residual:.3e}): the evaluation's rounding exceeds what the state's resolves; use \
+         fewer segments or a smaller stretching stiffness (larger model.rod_diameter)"
     )]
     RoundOff {
-        /// At which iteration.
+        /// The iteration the stall began at.
         iteration: usize,
         /// Relative gradient there.
         residual: f64,
+        /// ‖∇E‖ there.
+        gradient: f64,
+        /// The measured floor there.
+        floor: f64,
     },
     /// The line search could not decrease the energy.
     #[error(
@@ -151,43 +155,180 @@ pub fn armijo(merit0: f64, slope: f64, mut merit: impl FnMut(f64) -> Option<f64>
     None
 }
 
-/// Relative gradient (against the scale of the internal forces) and whether
-/// the gradient is at its round-off floor, ε × largest stiffness × extent × √n:
-/// below it no step can improve it. Shared by Newton and the continuation
-/// corrector.
-pub fn residual(
+/// The one convergence test of every solver (Newton, SQP, the continuation
+/// corrector): the iterate is converged when its relative gradient (against
+/// the scale of the internal forces) is at most `tol`, or when ‖∇E‖ is at its
+/// *measured* round-off floor — the change of the gradient under one rounding
+/// unit of every coordinate (`FloorProbe`), below which no step can reduce
+/// it. The floor is measured only when ‖∇E‖ lies under `floor_bound`, an
+/// upper bound of it (checked by `tests/reliability.rs`), so a solve far from
+/// its floor costs nothing extra. Returns the relative gradient and the
+/// measured floor when ‖∇E‖ is at it.
+pub fn judge(
     info: &GradientInfo,
     gnorm: f64,
-    max_diagonal: f64,
-    state: &RodState,
-    dofs: usize,
-) -> (f64, bool) {
-    let rel = if info.force_scale > 1e-300 {
+    tol: f64,
+    bound: f64,
+    measure: impl FnOnce() -> f64,
+) -> Judgement {
+    // no internal force at all (a rod at rest): only the floor can judge
+    let rel = if info.force_scale > 0.0 {
         gnorm / info.force_scale
-    } else {
+    } else if gnorm == 0.0 {
         0.0
+    } else {
+        f64::INFINITY
     };
-    // a floor above a relative gradient of 1e-6 is not an equilibrium to
-    // trust: the problem is past what f64 resolves (see `stalled`)
-    (
+    if rel <= tol {
+        return Judgement {
+            gradient: gnorm,
+            rel,
+            floor: None,
+            converged: true,
+        };
+    }
+    if gnorm > bound {
+        return Judgement {
+            gradient: gnorm,
+            rel,
+            floor: None,
+            converged: false,
+        };
+    }
+    let floor = measure();
+    Judgement {
+        gradient: gnorm,
         rel,
-        gnorm <= round_off_floor(max_diagonal, state, dofs) && rel <= FLOOR_TRUST,
-    )
+        floor: Some(floor),
+        converged: gnorm <= floor,
+    }
 }
 
-/// The gradient norm below which no step can improve it: ε × largest
-/// stiffness × extent × √n.
-fn round_off_floor(max_diagonal: f64, state: &RodState, dofs: usize) -> f64 {
+/// Iterates near the floor (where it was measured) after which a gradient
+/// that has not halved is stalled.
+const STALL_ITERATIONS: usize = 20;
+
+/// Watches for a gradient that stops decreasing above its measured floor, so
+/// that such a solve ends with [`SolveError::RoundOff`] instead of running
+/// out its iteration budget.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Stall {
+    best: Option<(usize, Judgement)>,
+    near: usize,
+}
+
+impl Stall {
+    /// Account for iterate `iteration`; the error once stalled.
+    pub fn check(&mut self, iteration: usize, j: &Judgement) -> Result<(), SolveError> {
+        let Some(floor) = j.floor else {
+            return Ok(());
+        };
+        match self.best {
+            Some((_, b)) if j.gradient > 0.5 * b.gradient => self.near += 1,
+            _ => {
+                self.best = Some((iteration, *j));
+                self.near = 0;
+            }
+        }
+        match self.best {
+            Some((at, b)) if self.near >= STALL_ITERATIONS => Err(SolveError::RoundOff {
+                iteration: at,
+                residual: b.rel,
+                gradient: b.gradient,
+                floor: b.floor.unwrap_or(floor),
+            }),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// What [`judge`] found of one iterate.
+#[derive(Clone, Copy, Debug)]
+pub struct Judgement {
+    /// ‖∇E‖.
+    pub gradient: f64,
+    /// ‖∇E‖ over the scale of the internal forces.
+    pub rel: f64,
+    /// The measured round-off floor of ‖∇E‖, where it was measured.
+    pub floor: Option<f64>,
+    /// Whether the iterate is an equilibrium to the tolerance or to the floor.
+    pub converged: bool,
+}
+
+/// An upper bound of the round-off floor of ‖∇E‖: 16 ε × largest stiffness
+/// × extent × √n plus 16 ε √n × the force scale (a gradient of forces that
+/// cancel carries their rounding). Only a gate for measuring the floor,
+/// never a criterion.
+pub fn floor_bound(info: &GradientInfo, max_diagonal: f64, state: &RodState, dofs: usize) -> f64 {
     let extent = state.nodes.iter().map(|x| x.amax()).fold(0.0, f64::max);
-    16.0 * f64::EPSILON * max_diagonal * extent.max(1e-3) * (dofs as f64).sqrt()
+    16.0 * f64::EPSILON
+        * (dofs as f64).sqrt()
+        * (max_diagonal * extent.max(1e-3) + info.force_scale)
 }
 
-/// The largest relative gradient accepted at the round-off floor.
-pub const FLOOR_TRUST: f64 = 1e-6;
+/// Scratch of the measured round-off floor, allocated on first use and
+/// reused by every later measurement of the same solver.
+#[derive(Clone, Debug, Default)]
+pub struct FloorProbe {
+    step: Vec<f64>,
+    plus: Vec<f64>,
+    minus: Vec<f64>,
+    states: Option<(RodState, RodState)>,
+}
 
-/// Whether the gradient is at its round-off floor while the relative
-/// gradient is still above `FLOOR_TRUST`: no step can improve it, and the
-/// state is no equilibrium worth reporting.
-pub fn stalled(gnorm: f64, rel: f64, max_diagonal: f64, state: &RodState, dofs: usize) -> bool {
-    rel > FLOOR_TRUST && gnorm <= round_off_floor(max_diagonal, state, dofs)
+impl FloorProbe {
+    /// ¼‖∇E(x + δ) − ∇E(x − δ)‖ with δ one unit in the last place of every
+    /// free coordinate (x ± δ are exact floats), in a fixed sign pattern: the
+    /// change of the gradient under the largest rounding error of the state,
+    /// half a unit, plus the evaluation's own rounding — what no Newton step
+    /// can undo (a correctly rounded equilibrium's gradient is about 0.6 of
+    /// it: its rounding errors spread evenly over ±½ unit). The signs are a fixed hash of the dof index, so the result
+    /// does not depend on threads or runs.
+    pub fn measure(&mut self, energy: &RodEnergy, state: &RodState) -> f64 {
+        let map = energy.map;
+        let n = map.len();
+        self.step.resize(n, 0.0);
+        self.plus.resize(n, 0.0);
+        self.minus.resize(n, 0.0);
+        let step = &mut self.step;
+        for i in map.free_nodes() {
+            let d = map.node(i).expect("a free node has dofs");
+            for c in 0..3 {
+                step[d + c] = sign(d + c) * ulp(state.nodes[i][c]);
+            }
+        }
+        for j in map.free_angles() {
+            let d = map.theta(j).expect("a free angle has a dof");
+            step[d] = sign(d) * ulp(state.theta[j]);
+        }
+        let (plus, minus) = self
+            .states
+            .get_or_insert_with(|| (state.clone(), state.clone()));
+        state.displace_into(&map, step, plus);
+        step.iter_mut().for_each(|v| *v = -*v);
+        state.displace_into(&map, step, minus);
+        energy.gradient(plus, &mut self.plus);
+        energy.gradient(minus, &mut self.minus);
+        0.25 * self
+            .plus
+            .iter()
+            .zip(&self.minus)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt()
+    }
+}
+
+/// The spacing of the floats above |x| (0 at 0, which is exact).
+fn ulp(x: f64) -> f64 {
+    let a = x.abs();
+    if a == 0.0 { 0.0 } else { a.next_up() - a }
+}
+
+/// ±1 from a fixed hash of `d` (splitmix64's finaliser).
+fn sign(d: usize) -> f64 {
+    let mut z = (d as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    if (z ^ (z >> 31)) & 1 == 0 { 1.0 } else { -1.0 }
 }

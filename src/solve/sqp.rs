@@ -18,7 +18,9 @@ use crate::model::contact_hessian::ContactHessian;
 use crate::model::energy::RodEnergy;
 use crate::model::rod::RodState;
 use crate::solve::kkt::Kkt;
-use crate::solve::outcome::{SolveError, SolveReport, SolverSettings, armijo, residual};
+use crate::solve::outcome::{
+    FloorProbe, SolveError, SolveReport, SolverSettings, armijo, floor_bound, judge,
+};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettings, DefaultSolver, IPSolver, SolverStatus,
@@ -209,9 +211,12 @@ impl QpHessian<'_> {
 struct Residuals {
     /// Largest |diagonal| of the energy Hessian.
     max_diag: f64,
-    /// Relative Lagrangian gradient, and whether it is at its round-off floor.
+    /// Relative Lagrangian gradient, and whether it passes the one
+    /// convergence test (`judge`) at the solver's tolerance.
     rel: f64,
     at_floor: bool,
+    /// Scratch of the measured round-off floor.
+    floor: FloorProbe,
     /// Largest |u2|, and largest penetration.
     infeasibility: f64,
     penetration: f64,
@@ -365,8 +370,14 @@ impl<'a> Sqp<'a> {
         self.lagrangian_gradient();
         let gnorm = self.lagrangian.iter().map(|x| x * x).sum::<f64>().sqrt();
         self.res.max_diag = energy.pattern.max_abs_diagonal(&self.hessian.values);
-        (self.res.rel, self.res.at_floor) =
-            residual(&info, gnorm, self.res.max_diag, self.state, self.n);
+        // the floor of the Lagrangian gradient is that of ∇E: the rows'
+        // rounding moves with the same coordinates
+        let bound = floor_bound(&info, self.res.max_diag, self.state, self.n);
+        let (floor, state) = (&mut self.res.floor, &*self.state);
+        let judgement = judge(&info, gnorm, self.settings.gradient_tol, bound, || {
+            floor.measure(energy, state)
+        });
+        (self.res.rel, self.res.at_floor) = (judgement.rel, judgement.converged);
         let h = self.h;
         self.res.infeasibility = self.c.iter().map(|x| (x / h).abs()).fold(0.0, f64::max);
         self.res.penetration = self.gaps.iter().map(|g| -g.gap).fold(0.0, f64::max);

@@ -16,6 +16,7 @@ mod general;
 mod islands;
 mod loading;
 mod paper;
+mod roundoff;
 mod runs;
 mod strip;
 
@@ -39,6 +40,7 @@ pub fn report(scenes: &Path) -> Result<String> {
         env!("CARGO_PKG_VERSION")
     )?;
     s += &analytic::section()?;
+    s += &roundoff::section()?;
     s += &paper::sections(&d, &e)?;
     s += &figure3::section(&d)?;
     s += &islands::kirchhoff_section(scenes)?;
