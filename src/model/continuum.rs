@@ -127,7 +127,7 @@ const STRIP: usize = 23;
 /// Steps of one integration before it counts as blown up.
 const MAX_STEPS: u32 = 20_000;
 // the rod's state (A.2) and its derivatives in the six unknowns
-const VARIATIONAL: usize = 19 * 7;
+pub(crate) const VARIATIONAL: usize = 19 * 7;
 
 struct Rhs<F>(F);
 
@@ -475,30 +475,8 @@ impl Continuum {
             }
             return Ok((r, jac));
         };
-        let mut y0 = SVector::<f64, VARIATIONAL>::zeros();
-        y0.fixed_rows_mut::<19>(0)
-            .copy_from(&self.rod_start(p).fixed_rows::<19>(0));
-        for c in 0..6 {
-            // ∂y(0)/∂p_c: the unit vector of n(0) or m(0)'s component c
-            y0[19 * (c + 1) + 12 + c] = 1.0;
-        }
-        let f = |s: f64, y: &SVector<f64, VARIATIONAL>| {
-            let natural = self.natural.vector_at(s);
-            let rhs = |y: &OdeState| rhs_loaded(y, k2, k3, &self.weight, &natural);
-            let core: OdeState = y.fixed_rows::<19>(0).into();
-            let mut dy = SVector::<f64, VARIATIONAL>::zeros();
-            dy.fixed_rows_mut::<19>(0).copy_from(&rhs(&core));
-            for c in 1..7 {
-                let delta: OdeState = y.fixed_rows::<19>(19 * c).into();
-                // exact for a quadratic right-hand side at any scale of δ;
-                // the scale keeps round-off relative to |y|
-                let scale = 1.0 / delta.norm().max(1.0);
-                let jd =
-                    (rhs(&(core + scale * delta)) - rhs(&(core - scale * delta))) / (2.0 * scale);
-                dy.fixed_rows_mut::<19>(19 * c).copy_from(&jd);
-            }
-            dy
-        };
+        let y0 = self.variational_start(p);
+        let f = |s: f64, y: &SVector<f64, VARIATIONAL>| self.variational_rhs(s, y, k2, k3, 0.0);
         let end = integrate_stops(y0, f, self.tolerance, &[1.0])?.0[0];
         let core: OdeState = end.fixed_rows::<19>(0).into();
         let residual_of = |y: &OdeState| {
@@ -522,6 +500,52 @@ impl Continuum {
             return Err(ContinuumError::Singular);
         }
         Ok((r, jac))
+    }
+
+    /// The rod's state at s = 0 from `p` and its derivatives in the six
+    /// unknowns (unit vectors of n(0) and m(0)'s components).
+    pub(crate) fn variational_start(&self, p: &Unknowns) -> SVector<f64, VARIATIONAL> {
+        let mut y0 = SVector::<f64, VARIATIONAL>::zeros();
+        y0.fixed_rows_mut::<19>(0)
+            .copy_from(&self.rod_start(p).fixed_rows::<19>(0));
+        for c in 0..6 {
+            y0[19 * (c + 1) + 12 + c] = 1.0;
+        }
+        y0
+    }
+
+    /// (A.2) and its linearisation along six perturbations; with `lambda` =
+    /// ω² the perturbations obey the linearised dynamics (A.4): each n̄_i'
+    /// gains −ω² r̄·d_i (unit mass per length, no rotary inertia).
+    pub(crate) fn variational_rhs(
+        &self,
+        s: f64,
+        y: &SVector<f64, VARIATIONAL>,
+        k2: f64,
+        k3: f64,
+        lambda: f64,
+    ) -> SVector<f64, VARIATIONAL> {
+        let natural = self.natural.vector_at(s);
+        let rhs = |y: &OdeState| rhs_loaded(y, k2, k3, &self.weight, &natural);
+        let core: OdeState = y.fixed_rows::<19>(0).into();
+        let mut dy = SVector::<f64, VARIATIONAL>::zeros();
+        dy.fixed_rows_mut::<19>(0).copy_from(&rhs(&core));
+        for c in 1..7 {
+            let delta: OdeState = y.fixed_rows::<19>(19 * c).into();
+            // exact for a quadratic right-hand side at any scale of δ;
+            // the scale keeps round-off relative to |y|
+            let scale = 1.0 / delta.norm().max(1.0);
+            let mut jd =
+                (rhs(&(core + scale * delta)) - rhs(&(core - scale * delta))) / (2.0 * scale);
+            if lambda != 0.0 {
+                let r = part(&delta, 0);
+                for i in 0..3 {
+                    jd[12 + i] -= lambda * r.dot(&part(&core, 1 + i));
+                }
+            }
+            dy.fixed_rows_mut::<19>(19 * c).copy_from(&jd);
+        }
+        dy
     }
 
     /// The solution from an integration whose state holds r, d1, d2, d3, n,

@@ -1,0 +1,65 @@
+//! Stability on the continuum (issue 39): the frequencies ω² of (A.4)
+//! from the shooting determinant, counted by conjugate points, against the
+//! discrete rod's Richardson values.
+
+use knotrod::model::continuum::Continuum;
+use knotrod::scene::Scene;
+use nalgebra::Vector6;
+
+/// The continuum problem of `scene` at its clamps, polished from its
+/// shooting unknowns.
+fn polished(scene: &Scene) -> (Continuum, Vector6<f64>) {
+    let c = Continuum::of(&scene.rod_model(None), scene.clamps(), 1e-12).unwrap();
+    let (n, m) = (scene.initial.n0.unwrap(), scene.initial.m0.unwrap());
+    let p = Vector6::new(n[0], n[1], n[2], m[0], m[1], m[2]);
+    let q = c.polish(&p).unwrap().unknowns;
+    (c, q)
+}
+
+#[test]
+fn the_appendix_d_knot_is_stable_on_the_continuum_with_the_rods_lowest_frequency() {
+    let scene = Scene::load(std::path::Path::new("scenes/appendix_d.toml")).unwrap();
+    let (c, p) = polished(&scene);
+    let spectrum = c.lowest_frequencies(&p, 2, 100.0).unwrap();
+    eprintln!("{spectrum:?}");
+    assert_eq!(spectrum.negative, 0);
+    // the discrete rod: Richardson 167.7419 ± 1.4e-2 (N = 200, 400, 800,
+    // docs/verify/paper_appendices.md), stiffness error 3.2e-3
+    let (l1, e1) = (spectrum.values[0], spectrum.errors[0]);
+    assert!(
+        (l1 - 167.7419).abs() < 1.4e-2 + 3.2e-3 + e1,
+        "ω² = {l1} ± {e1}"
+    );
+    assert!(e1 < 1e-6, "error {e1}");
+    assert!(spectrum.values[1] > l1);
+}
+
+#[test]
+fn the_unstable_knot_from_s_has_its_negative_directions_on_the_continuum() {
+    // the non-symmetric knot of the branch born at S, at φ/2π = 0.76
+    // (scenes/verify/two_equilibria.toml): one negative direction for the
+    // discrete rod, lowest ω² -133.3558 ± 1.0e-1 by Richardson of N = 100,
+    // 200, 400, stiffness error 2.5e-3
+    let text = std::fs::read_to_string("scenes/appendix_d.toml").unwrap();
+    let text = text
+        .replace("phi_over_2pi = 0.802", "phi_over_2pi = 0.76")
+        .replace(
+            "n0 = [-24.743, 17.772, 37.145]",
+            "n0 = [-15.193167635, 64.953033666, 0.958779246]",
+        )
+        .replace(
+            "m0 = [7.5317, -8.7100, 4.529]",
+            "m0 = [7.606847029, -0.325753296, 16.410793040]",
+        );
+    let scene = Scene::parse(&text).unwrap();
+    let (c, p) = polished(&scene);
+    let spectrum = c.lowest_frequencies(&p, 2, 100.0).unwrap();
+    eprintln!("{spectrum:?}");
+    assert_eq!(spectrum.negative, 1);
+    let (l1, e1) = (spectrum.values[0], spectrum.errors[0]);
+    assert!(
+        (l1 + 133.3558).abs() < 1.0e-1 + 2.5e-3 + e1,
+        "ω² = {l1} ± {e1}"
+    );
+    assert!(spectrum.values[1] > 0.0);
+}
