@@ -63,3 +63,25 @@ fn the_unstable_knot_from_s_has_its_negative_directions_on_the_continuum() {
     );
     assert!(spectrum.values[1] > 0.0);
 }
+
+#[test]
+fn the_figure_8_strip_knot_is_stable_on_the_continuum() {
+    // the strip's unknowns n(0), u1(0), m2(0), u3(0)
+    // (scenes/verify/fig8_strip_knot.toml, polished by verify)
+    let scene = Scene::load(std::path::Path::new("scenes/fig8_strip_knot.toml")).unwrap();
+    let c = Continuum::of(&scene.rod_model(None), scene.clamps(), 1e-12).unwrap();
+    let p = Vector6::new(-8.43069, 1.60824, 72.0790, 7.65134, -4.23332, 0.0816504);
+    let p = c.polish(&p).unwrap().unknowns;
+    let spectrum = c.lowest_frequencies(&p, 2, 500.0).unwrap();
+    eprintln!("{spectrum:?}");
+    assert_eq!(spectrum.negative, 0);
+    // the discrete strip's Richardson value at N = 100, 200, 400 is
+    // 527.92 ± 0.15 (biased: issue 39, defect 7, moving away as N grows);
+    // the issue quotes 528.238 from four methods, 9e-5 above this one: open
+    // until a second continuum method (collocation) settles it. Until then
+    // this pins the determinant's value, and its own error bar
+    let (l1, e1) = (spectrum.values[0], spectrum.errors[0]);
+    assert!(e1 < 1e-5, "error {e1}");
+    assert!((l1 - 528.18946).abs() < 1e-4 + e1, "ω² = {l1} ± {e1}");
+    assert!(spectrum.values[1] > l1);
+}

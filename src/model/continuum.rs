@@ -363,7 +363,7 @@ impl Continuum {
     }
 
     /// The strip's state at s = 0 from n(0), u1(0), m2(0), u3(0), and m(0).
-    fn strip_start(
+    pub(crate) fn strip_start(
         &self,
         p: &Unknowns,
         regularisation: f64,

@@ -1,6 +1,7 @@
 //! Stability on the continuum, independent of the discrete rod: the
 //! frequencies ω² of the linearised dynamics (A.4) about a Kirchhoff
-//! equilibrium clamped at both ends. The six perturbations started at s = 0
+//! equilibrium clamped at both ends, and of the strip's equations (A.1 with
+//! 4.3) likewise. The six perturbations started at s = 0
 //! by unit n̄(0), m̄(0) (r̄ = α = 0 there) are integrated with the
 //! equilibrium (`Continuum::variational_rhs`); their block B(s) = [r̄; α]
 //! is singular at s = 1 exactly when ω² is an eigenvalue (the shooting
@@ -13,6 +14,7 @@ use crate::model::continuum::{
     Continuum, ContinuumError, ContinuumLaw, Unknowns, VARIATIONAL, integrate_stops,
 };
 use crate::model::rod::EndKind;
+use crate::model::strip_shooting::{StripOdeState, strip_rhs};
 use nalgebra::{Matrix6, SVector, Vector3};
 
 /// Samples of det B(s) in (0, 1] counted for sign changes.
@@ -33,21 +35,24 @@ pub struct ContinuumSpectrum {
     pub errors: Vec<f64>,
 }
 
-fn part(y: &SVector<f64, 19>, k: usize) -> Vector3<f64> {
+/// The strip's state then its derivatives in the six unknowns.
+const STRIP_VARIATIONAL: usize = 21 * 7;
+
+fn part(y: &[f64], k: usize) -> Vector3<f64> {
     Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
 }
 
-/// B = [r̄; α] of the six perturbations in `y`, α = ½ Σ d_i × d̄_i (the
-/// small rotation d̄_i = α × d_i).
-fn block(y: &SVector<f64, VARIATIONAL>) -> Matrix6<f64> {
-    let core: SVector<f64, 19> = y.fixed_rows::<19>(0).into();
+/// B = [r̄; α] of the six perturbations in `y` (the state, then each
+/// perturbation, `core` entries each, r, d1, d2, d3 first), α = ½ Σ d_i × d̄_i
+/// (the small rotation d̄_i = α × d_i).
+fn block(y: &[f64], core: usize) -> Matrix6<f64> {
     let mut b = Matrix6::zeros();
     for c in 0..6 {
-        let delta: SVector<f64, 19> = y.fixed_rows::<19>(19 * (c + 1)).into();
-        let r = part(&delta, 0);
+        let delta = &y[core * (c + 1)..core * (c + 2)];
+        let r = part(delta, 0);
         let alpha = 0.5
             * (1..4)
-                .map(|i| part(&core, i).cross(&part(&delta, i)))
+                .map(|i| part(y, i).cross(&part(delta, i)))
                 .fold(Vector3::zeros(), |a, v| a + v);
         for k in 0..3 {
             b[(k, c)] = r[k];
@@ -65,20 +70,87 @@ impl Continuum {
         lambda: f64,
         stops: &[f64],
     ) -> Result<Vec<f64>, ContinuumError> {
-        let ContinuumLaw::Kirchhoff { k2, k3 } = self.law else {
-            return Err(ContinuumError::Unsupported(
-                "the stability of a strip (its perturbation system is not (A.4))",
-            ));
-        };
         if self.clamps.ends.end != EndKind::Clamped || self.clamps.ends.start != EndKind::Clamped {
             return Err(ContinuumError::Unsupported(
                 "the stability of a rod that is not clamped at both ends",
             ));
         }
-        let y0 = self.variational_start(p);
-        let f = |s: f64, y: &SVector<f64, VARIATIONAL>| self.variational_rhs(s, y, k2, k3, lambda);
-        let (ys, _) = integrate_stops(y0, f, self.tolerance, stops)?;
-        Ok(ys.iter().map(|y| block(y).determinant()).collect())
+        let dets = match self.law {
+            ContinuumLaw::Kirchhoff { k2, k3 } => {
+                let y0 = self.variational_start(p);
+                let f = |s: f64, y: &SVector<f64, VARIATIONAL>| {
+                    self.variational_rhs(s, y, k2, k3, lambda)
+                };
+                let (ys, _) = integrate_stops(y0, f, self.tolerance, stops)?;
+                ys.iter()
+                    .map(|y| block(y.as_slice(), 19).determinant())
+                    .collect()
+            }
+            ContinuumLaw::Strip { regularisation } => {
+                let y0 = self.strip_variational_start(p, regularisation);
+                let f = |s: f64, y: &SVector<f64, STRIP_VARIATIONAL>| {
+                    self.strip_variational_rhs(s, y, regularisation, lambda)
+                };
+                let (ys, _) = integrate_stops(y0, f, self.tolerance, stops)?;
+                ys.iter()
+                    .map(|y| block(y.as_slice(), 21).determinant())
+                    .collect()
+            }
+        };
+        Ok(dets)
+    }
+
+    /// The strip's state at s = 0 and its derivatives in the six unknowns
+    /// n(0), u1(0), m2(0), u3(0) (central differences: m1(0), m3(0) follow
+    /// u1(0), u3(0) through the law).
+    fn strip_variational_start(
+        &self,
+        p: &Unknowns,
+        regularisation: f64,
+    ) -> SVector<f64, STRIP_VARIATIONAL> {
+        let mut y0 = SVector::<f64, STRIP_VARIATIONAL>::zeros();
+        let start = |q: &Unknowns| self.strip_start(q, regularisation).0;
+        y0.fixed_rows_mut::<21>(0)
+            .copy_from(&start(p).fixed_rows::<21>(0));
+        for c in 0..6 {
+            let h = 1e-6 * p[c].abs().max(1.0);
+            let mut q = *p;
+            q[c] += h;
+            let plus = start(&q);
+            q[c] -= 2.0 * h;
+            let minus = start(&q);
+            for k in 0..21 {
+                y0[21 * (c + 1) + k] = (plus[k] - minus[k]) / (2.0 * h);
+            }
+        }
+        y0
+    }
+
+    /// The strip's equations and their linearisation along six
+    /// perturbations (central differences at a relative step of 1e-6; the
+    /// law is not quadratic), each n̄_i' with −ω² r̄·d_i.
+    fn strip_variational_rhs(
+        &self,
+        s: f64,
+        y: &SVector<f64, STRIP_VARIATIONAL>,
+        regularisation: f64,
+        lambda: f64,
+    ) -> SVector<f64, STRIP_VARIATIONAL> {
+        let rhs = |y: &StripOdeState| strip_rhs(s, y, regularisation, &self.weight, &self.natural);
+        let core: StripOdeState = y.fixed_rows::<21>(0).into();
+        let mut dy = SVector::<f64, STRIP_VARIATIONAL>::zeros();
+        dy.fixed_rows_mut::<21>(0).copy_from(&rhs(&core));
+        for c in 1..7 {
+            let delta: StripOdeState = y.fixed_rows::<21>(21 * c).into();
+            let h = 1e-6 * core.norm().max(1.0) / delta.norm().max(1e-300);
+            let mut jd = (rhs(&(core + h * delta)) - rhs(&(core - h * delta))) / (2.0 * h);
+            let r = part(delta.as_slice(), 0);
+            for i in 0..3 {
+                jd[12 + i] -= lambda * r.dot(&part(core.as_slice(), 1 + i));
+            }
+            dy.fixed_rows_mut::<21>(21 * c).copy_from(&jd);
+        }
+        dy
     }
 
     /// The shooting determinant D(ω²) = det B(1): zero at an eigenvalue.
