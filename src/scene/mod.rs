@@ -245,7 +245,7 @@ impl RotationSpec {
                 // its norm measured without overflow: 1e300 components are
                 // refused, not taken for a quaternion of norm inf
                 let norm = scaled_norm(&q);
-                if !((norm - 1.0).abs() <= 1e-9) {
+                if (norm - 1.0).abs() > 1e-9 {
                     return Err(format!(
                         "a quaternion of norm {} is not a rotation (norm 1 within 1e-9)",
                         short(norm)
