@@ -121,7 +121,7 @@ impl Scene {
                 what: "memory",
                 estimate: format!("{:.3} GB", e.memory_bytes / 1e9),
                 drivers: e.memory_from,
-                limit: format!("{} GB", b.memory_gb),
+                limit: format!("{} GB", crate::scene::short(b.memory_gb)),
                 key: "budget.memory_gb",
             });
         }

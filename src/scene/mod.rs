@@ -9,7 +9,10 @@ mod limits;
 mod map;
 mod validate;
 
-pub use limits::{BudgetSpec, Estimate, Job, human_time};
+pub use limits::{
+    BudgetSpec, Estimate, Job, MAX_ANGLE, MAX_NATURAL_STRAIN, MAX_POSITION, MAX_TURNS, MAX_WEIGHT,
+    STIFFNESS_RATIO, human_time, parameter_range, short,
+};
 pub use map::{MapSpec, SliceSpec};
 
 use crate::analysis::class::{Clearance, GoodKnot};
@@ -239,25 +242,27 @@ impl RotationSpec {
                 if !all_finite(&q) {
                     return Err("quaternion components must be finite".into());
                 }
-                let q = Quaternion::new(q[0], q[1], q[2], q[3]);
-                if (q.norm() - 1.0).abs() > 1e-9 {
+                // its norm measured without overflow: 1e300 components are
+                // refused, not taken for a quaternion of norm inf
+                let norm = scaled_norm(&q);
+                if (norm - 1.0).abs() > 1e-9 {
                     return Err(format!(
                         "a quaternion of norm {} is not a rotation (norm 1 within 1e-9)",
-                        q.norm()
+                        short(norm)
                     ));
                 }
+                let q = Quaternion::new(q[0], q[1], q[2], q[3]);
                 Ok(UnitQuaternion::new_normalize(q))
             }
             RotationSpec::AxisAngle(a) => {
                 if !all_finite(&a) {
                     return Err("axis and angle must be finite".into());
                 }
-                let axis = Vector3::new(a[0], a[1], a[2]);
-                if axis.norm() < 1e-12 {
-                    return Err("the axis must be nonzero".into());
-                }
+                let axis =
+                    unit_vector([a[0], a[1], a[2]]).map_err(|why| format!("the axis {why}"))?;
+                angle("the angle", a[3])?;
                 Ok(UnitQuaternion::from_axis_angle(
-                    &Unit::new_normalize(axis),
+                    &Unit::new_unchecked(Vector3::from(axis)),
                     a[3],
                 ))
             }
@@ -265,10 +270,65 @@ impl RotationSpec {
                 if !all_finite(&[a, b, c]) {
                     return Err("Euler angles must be finite".into());
                 }
+                for v in [a, b, c] {
+                    angle("each Euler angle", v)?;
+                }
                 Ok(UnitQuaternion::from_euler_angles(c, b, a))
             }
         }
     }
+}
+
+/// An angle in radians within [`MAX_ANGLE`], or why not.
+fn angle(what: &str, v: f64) -> Result<(), String> {
+    if v.abs() <= MAX_ANGLE {
+        Ok(())
+    } else {
+        Err(format!(
+            "{what} must be within ±{} radians ({MAX_TURNS} turns), got {}",
+            short(MAX_ANGLE),
+            short(v)
+        ))
+    }
+}
+
+/// The largest |component| of `v`.
+fn largest(v: &[f64]) -> f64 {
+    v.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+}
+
+/// The Euclidean norm of `v`, taken of `v` scaled by its largest component
+/// so that no square overflows or underflows (inf only past f64's range).
+fn scaled_norm(v: &[f64]) -> f64 {
+    let m = largest(v);
+    if m == 0.0 || !m.is_finite() {
+        return m;
+    }
+    m * v.iter().map(|x| (x / m) * (x / m)).sum::<f64>().sqrt()
+}
+
+/// `v` as a unit vector: a direction from input, scaled by its largest
+/// component before its norm is taken, so that neither 1e300 components
+/// overflow the norm nor 1e-300 ones underflow it; or why it is no direction
+/// (zero, not finite, or subnormal: a largest component below 2.2e-308
+/// holds too few digits to say where it points).
+pub(crate) fn unit_vector<const N: usize>(v: [f64; N]) -> Result<[f64; N], &'static str> {
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err("must be finite");
+    }
+    let m = largest(&v);
+    if m == 0.0 {
+        return Err("must be a non-zero vector");
+    }
+    if m < f64::MIN_POSITIVE {
+        return Err(
+            "is subnormal (every component below 2.2e-308): too small to give a \
+                    direction to f64's precision; scale it up",
+        );
+    }
+    let scaled = v.map(|x| x / m);
+    let norm = scaled_norm(&scaled);
+    Ok(scaled.map(|x| x / norm))
 }
 
 impl ClampSpec {
@@ -469,6 +529,28 @@ pub struct LoadingSpec {
     pub targets: std::collections::BTreeMap<Parameter, f64>,
     /// Number of equal steps.
     pub steps: i64,
+    /// Newton iterations each step may take in all, the location of a jump,
+    /// a wall or a lost contact on it included (default
+    /// [`LoadingSpec::DEFAULT_STEP_BUDGET`] × `solver.max_iterations`).
+    #[serde(default)]
+    pub step_iterations: Option<i64>,
+}
+
+impl LoadingSpec {
+    /// Default budget of a step, in `solver.max_iterations`: the jump of
+    /// scenes/loading_hysteresis.toml (located by some 27 bisections, then
+    /// the landing) takes 3000–5000 iterations in all, the other shipped
+    /// paths' steps fewer; 50 000 at the default 1000 is ten times that, and
+    /// still stops a path that cannot settle.
+    pub const DEFAULT_STEP_BUDGET: usize = 50;
+
+    /// The Newton iterations each step of this leg may take in all.
+    pub fn step_budget(&self, settings: &SolverSettings) -> usize {
+        self.step_iterations.map_or_else(
+            || Self::DEFAULT_STEP_BUDGET.saturating_mul(settings.max_iterations),
+            |n| n as usize,
+        )
+    }
 }
 
 /// `[sweep]`
@@ -566,12 +648,17 @@ fn default_gravity() -> [f64; 3] {
 impl LoadSpec {
     /// The body force per unit length, w g.
     pub fn weight_vector(&self) -> [f64; 3] {
-        let d = nalgebra::Vector3::from(self.direction);
-        let n = d.norm();
-        if self.weight == 0.0 || n == 0.0 {
+        if self.weight == 0.0 {
             return [0.0; 3];
         }
-        (d * (self.weight / n)).into()
+        // validation refused a direction that is none where the weight is not 0
+        self.unit_direction().map(|d| self.weight * d)
+    }
+
+    /// The direction of gravity as a unit vector (−e3 where it is none:
+    /// validation refuses that wherever the weight can be non-zero).
+    pub fn unit_direction(&self) -> [f64; 3] {
+        unit_vector(self.direction).unwrap_or([0.0, 0.0, -1.0])
     }
 }
 
@@ -681,7 +768,7 @@ pub(crate) fn positive(field: &'static str, v: f64) -> Result<f64, SceneError> {
     if v > 0.0 {
         Ok(v)
     } else {
-        Err(invalid(field, format!("must be > 0, got {v}")))
+        Err(invalid(field, format!("must be > 0, got {}", short(v))))
     }
 }
 
@@ -864,13 +951,7 @@ impl Scene {
         };
         if self.varied().iter().any(Parameter::is_model) {
             // the states carry the model's scalars the scene varies
-            let d = nalgebra::Vector3::from(self.load.direction);
-            let direction = if d.norm() > 0.0 {
-                (d / d.norm()).into()
-            } else {
-                [0.0, 0.0, -1.0]
-            };
-            clamps.scalars = ModelScalars::of(&self.rod_model(None), direction);
+            clamps.scalars = ModelScalars::of(&self.rod_model(None), self.load.unit_direction());
         }
         if let Some(st) = &c.start {
             clamps.start = StartClamp {

@@ -2,7 +2,10 @@
 
 use crate::model::rod::{Clamps, EndKind, Parameter};
 use crate::scene::InitialShape;
-use crate::scene::{Scene, SceneError, finite, invalid, positive};
+use crate::scene::{
+    MAX_NATURAL_STRAIN, MAX_POSITION, Scene, SceneError, finite, invalid, parameter_range,
+    positive, short, unit_vector,
+};
 
 /// Most rows of a `model.natural_strains` table.
 pub const MAX_NATURAL_ROWS: usize = 100_000;
@@ -12,6 +15,9 @@ impl Scene {
     pub fn validate(&self) -> Result<(), SceneError> {
         self.check_model()?;
         self.check_clamps()?;
+        // every value a study gives a parameter, in range before anything
+        // is computed from it
+        self.check_varied()?;
         self.check_initial()?;
         self.check_solver()?;
         self.check_continuation()?;
@@ -24,7 +30,6 @@ impl Scene {
         self.check_reference()?;
         self.check_budget_spec()?;
         self.check_load()?;
-        self.check_varied()?;
         self.check_ends()?;
         Ok(())
     }
@@ -167,39 +172,63 @@ impl Scene {
         Ok(())
     }
 
-    /// `[load]`: a finite weight of sensible size along a non-zero direction.
+    /// `[load]`: a finite weight of sensible size along a direction,
+    /// wherever the weight is or can become non-zero (a study varying it).
     fn check_load(&self) -> Result<(), SceneError> {
         let l = &self.load;
-        finite("load.weight", l.weight)?;
-        if l.weight.abs() > 1e4 {
-            return Err(invalid(
-                "load.weight",
-                format!("|w L³ / B| must be <= 1e4, got {}", l.weight),
-            ));
-        }
+        self.check_value("load.weight", Parameter::Weight, l.weight)?;
         for v in l.direction {
             finite("load.direction", v)?;
         }
-        let n = l.direction.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if l.weight != 0.0 && n < 1e-12 {
-            return Err(invalid("load.direction", "must be a non-zero vector"));
+        let varied = self.varied().contains(&Parameter::Weight);
+        if l.weight != 0.0 || varied {
+            unit_vector(l.direction).map_err(|why| {
+                invalid(
+                    "load.direction",
+                    if varied && l.weight == 0.0 {
+                        format!("{why} (the scene varies the weight, which then acts along it)")
+                    } else {
+                        why.to_string()
+                    },
+                )
+            })?;
         }
         Ok(())
+    }
+
+    /// `v` as a value of the parameter `p`: finite and within its range
+    /// (`parameter_range`, declared once in limits.rs), the error naming
+    /// `field`, wherever the value comes from.
+    fn check_value(&self, field: &'static str, p: Parameter, v: f64) -> Result<(), SceneError> {
+        finite(field, v)?;
+        let strain = self
+            .model
+            .natural_strains
+            .values()
+            .iter()
+            .fold(0.0_f64, |m, u| m.max(u.abs()));
+        let (lo, hi, unit) = parameter_range(p, strain);
+        if (lo..=hi).contains(&v) {
+            return Ok(());
+        }
+        Err(invalid(
+            field,
+            format!(
+                "{} = {} is out of range: it must be in [{}, {}] ({unit})",
+                p.name(),
+                short(v),
+                short(lo),
+                short(hi)
+            ),
+        ))
     }
 
     /// `[model]`: a known kind, positive stiffnesses, N in range.
     fn check_model(&self) -> Result<(), SceneError> {
         let m = &self.model;
         positive("model.strip_regularisation", m.strip_regularisation)?;
-        positive("model.K2", m.k2)?;
-        positive("model.K3", m.k3)?;
-        // ratios of bending and twisting stiffnesses: past these the
-        // Hessian's condition number exceeds what f64 resolves
-        for (field, k) in [("model.K2", m.k2), ("model.K3", m.k3)] {
-            if !(1e-6..=1e6).contains(&k) {
-                return Err(invalid(field, format!("must be in [1e-6, 1e6], got {k}")));
-            }
-        }
+        self.check_value("model.K2", Parameter::K2, m.k2)?;
+        self.check_value("model.K3", Parameter::K3, m.k3)?;
         if m.segments < 4 || m.segments > 1_000_000 {
             return Err(invalid(
                 "model.segments",
@@ -214,7 +243,7 @@ impl Scene {
                 "model.rod_diameter",
                 format!(
                     "must be in [1e-5, 0.5] (rod lengths), got {}",
-                    m.rod_diameter
+                    short(m.rod_diameter)
                 ),
             ));
         }
@@ -225,7 +254,7 @@ impl Scene {
             if s > 1e12 {
                 return Err(invalid(
                     "model.stretching_stiffness",
-                    format!("must be <= 1e12 (EA L²/EI), got {s}"),
+                    format!("must be <= 1e12 (EA L²/EI), got {}", short(s)),
                 ));
             }
         }
@@ -243,7 +272,8 @@ impl Scene {
                 "model.strip_width",
                 format!(
                     "must be in [0, 0.5) (rod lengths): the strip law holds for a strip \
-                     narrow beside its length, got {w}"
+                     narrow beside its length, got {}",
+                    short(w)
                 ),
             ));
         }
@@ -282,28 +312,50 @@ impl Scene {
 
     /// `[clamps]`: finite, δ ≥ 0, the clamps no farther apart than the rod is long.
     fn check_clamps(&self) -> Result<(), SceneError> {
+        use Parameter as P;
         let c = &self.clamps;
-        finite("clamps.phi_over_2pi", c.phi_over_2pi)?;
-        for v in c.end_shift.iter().flatten() {
-            finite("clamps.end_shift", *v)?;
+        let mut values = vec![
+            ("clamps.z_star", P::ZStar, c.z_star),
+            ("clamps.delta", P::Delta, c.delta),
+            ("clamps.phi_over_2pi", P::Phi, c.phi_over_2pi),
+            ("clamps.end_tilt", P::EndTilt, c.end_tilt),
+            (
+                "clamps.end_tilt_azimuth",
+                P::EndTiltAzimuth,
+                c.end_tilt_azimuth,
+            ),
+        ];
+        if let Some([x, y]) = c.end_shift {
+            values.extend([
+                ("clamps.end_shift", P::EndX, x),
+                ("clamps.end_shift", P::EndY, y),
+            ]);
         }
-        finite("clamps.end_tilt", c.end_tilt)?;
-        finite("clamps.end_tilt_azimuth", c.end_tilt_azimuth)?;
+        if let Some(st) = &c.start {
+            let [x, y, z] = st.position;
+            values.extend([
+                ("clamps.start.position", P::StartX, x),
+                ("clamps.start.position", P::StartY, y),
+                ("clamps.start.position", P::StartZ, z),
+                ("clamps.start.tilt", P::StartTilt, st.tilt),
+                (
+                    "clamps.start.tilt_azimuth",
+                    P::StartTiltAzimuth,
+                    st.tilt_azimuth,
+                ),
+                ("clamps.start.turn_over_2pi", P::StartTurn, st.turn_over_2pi),
+            ]);
+        }
+        for (field, p, v) in values {
+            self.check_value(field, p, v)?;
+        }
         if let Some(r) = &c.end_rotation {
             r.quaternion()
                 .map_err(|why| invalid("clamps.end_rotation", why))?;
         }
-        if let Some(st) = &c.start {
-            for v in st.position {
-                finite("clamps.start.position", v)?;
-            }
-            finite("clamps.start.tilt", st.tilt)?;
-            finite("clamps.start.tilt_azimuth", st.tilt_azimuth)?;
-            finite("clamps.start.turn_over_2pi", st.turn_over_2pi)?;
-            if let Some(r) = &st.rotation {
-                r.quaternion()
-                    .map_err(|why| invalid("clamps.start.rotation", why))?;
-            }
+        if let Some(r) = c.start.as_ref().and_then(|st| st.rotation) {
+            r.quaternion()
+                .map_err(|why| invalid("clamps.start.rotation", why))?;
         }
         let general = !self.clamps().is_paper();
         if c.start.is_some()
@@ -352,7 +404,18 @@ impl Scene {
                 return Err(invalid(field_of(self, p), why));
             }
         }
+        for (field, p, v) in self.study_values() {
+            self.check_value(field, p, v)?;
+        }
+        Ok(())
+    }
+
+    /// Every value a study gives a parameter, with the field it comes from:
+    /// a continuation's range, a sweep's values, a map's axes and slices, a
+    /// loading path's targets (the scene's own fields are `check_clamps`').
+    fn study_values(&self) -> Vec<(&'static str, Parameter, f64)> {
         let mut values: Vec<(&'static str, Parameter, f64)> = Vec::new();
+        let branch = self.continuation.as_ref().map(|c| c.parameter);
         if let Some(c) = &self.continuation {
             values.extend(c.range.map(|v| ("continuation.range", c.parameter, v)));
         }
@@ -361,29 +424,39 @@ impl Scene {
         }
         if let Some(m) = &self.map {
             values.extend(m.range.map(|v| ("map.range", m.parameter, v)));
-        }
-        for l in &self.loading {
-            values.extend(l.targets.iter().map(|(p, v)| ("loading.targets", *p, *v)));
-        }
-        for (field, p, v) in values {
-            let ok = match p {
-                // K2 and K3 may pass through the range [1e-6, 1e6] of the scene's
-                Parameter::K2 | Parameter::K3 => (1e-6..=1e6).contains(&v),
-                Parameter::Weight => v.is_finite() && v.abs() <= 1e6,
-                Parameter::NaturalScale => v.is_finite() && v.abs() <= 1e3,
-                _ => true,
-            };
-            if !ok {
-                return Err(invalid(
-                    field,
-                    format!(
-                        "{} = {v} is out of range (K2, K3 in [1e-6, 1e6]; |weight| ≤ 1e6; |natural_scale| ≤ 1e3)",
-                        p.name()
-                    ),
-                ));
+            // points of the map's plane: (map parameter, branch parameter)
+            let slices = m
+                .slices
+                .iter()
+                .flat_map(|sl| sl.trace_from.iter().flatten());
+            let points = (m.trace_from.iter().map(|t| ("map.trace_from", t)))
+                .chain(slices.map(|t| ("map.slices.trace_from", t)));
+            for (field, [a, b]) in points {
+                values.push((field, m.parameter, *a));
+                values.extend(branch.map(|c| (field, c, *b)));
             }
         }
-        Ok(())
+        if let Some(sl) = self.map.as_ref().and_then(|m| m.slices.as_ref()) {
+            values.extend(
+                sl.values
+                    .iter()
+                    .map(|v| ("map.slices.values", sl.parameter, *v)),
+            );
+            for v in sl.start_phi_over_2pi.iter().flatten() {
+                values.push(("map.slices.start_phi_over_2pi", Parameter::Phi, *v));
+            }
+        }
+        for l in &self.loading {
+            for (field, p, v) in [
+                ("loading.z_star", Parameter::ZStar, l.z_star),
+                ("loading.delta", Parameter::Delta, l.delta),
+                ("loading.phi_over_2pi", Parameter::Phi, l.phi_over_2pi),
+            ] {
+                values.extend(v.map(|v| (field, p, v)));
+            }
+            values.extend(l.targets.iter().map(|(p, v)| ("loading.targets", *p, *v)));
+        }
+        values
     }
 
     /// The clamps where `parameter` takes the value `v` and the other
@@ -401,10 +474,14 @@ impl Scene {
         let m = &self.model;
         for v in m.natural_strains.values() {
             finite(FIELD, v)?;
-            if v.abs() > 1e3 {
+            if v.abs() > MAX_NATURAL_STRAIN {
                 return Err(invalid(
                     FIELD,
-                    format!("each |û_i| must be <= 1e3 (per rod length), got {v}"),
+                    format!(
+                        "each |û_i| must be <= {} (per rod length), got {}",
+                        short(MAX_NATURAL_STRAIN),
+                        short(v)
+                    ),
                 ));
             }
         }
@@ -426,7 +503,8 @@ impl Scene {
                     FIELD,
                     format!(
                         "the table's s must increase strictly, got {} then {}",
-                        w[0][0], w[1][0]
+                        short(w[0][0]),
+                        short(w[1][0])
                     ),
                 ));
             }
@@ -435,7 +513,9 @@ impl Scene {
                 return Err(invalid(
                     FIELD,
                     format!(
-                        "the table must cover s in [0, 1] from its first row at s = 0 to its last at s = 1, got [{first}, {last}]"
+                        "the table must cover s in [0, 1] from its first row at s = 0 to its last at s = 1, got [{}, {}]",
+                        short(first),
+                        short(last)
                     ),
                 ));
             }
@@ -495,7 +575,10 @@ impl Scene {
                     })?;
                     finite(field, v)?;
                     if v.abs() > 1e4 {
-                        return Err(invalid(field, format!("must be in [-1e4, 1e4], got {v}")));
+                        return Err(invalid(
+                            field,
+                            format!("must be in [-1e4, 1e4], got {}", short(v)),
+                        ));
                     }
                 }
             } else {
@@ -526,7 +609,10 @@ impl Scene {
             if v.abs() > 10.0 {
                 return Err(invalid(
                     "initial.bump",
-                    format!("each component must be in [-10, 10] (rod lengths), got {v}"),
+                    format!(
+                        "each component must be in [-10, 10] (rod lengths), got {}",
+                        short(*v)
+                    ),
                 ));
             }
         }
@@ -562,7 +648,7 @@ impl Scene {
             if start < c.range[0] || start > c.range[1] {
                 return Err(invalid(
                     "continuation.range",
-                    format!("does not contain the start value {start}"),
+                    format!("does not contain the start value {}", short(start)),
                 ));
             }
             for (field, v) in [
@@ -602,6 +688,14 @@ impl Scene {
                 return Err(invalid(
                     "loading.steps",
                     format!("must be in 1..=1000000, got {}", l.steps),
+                ));
+            }
+            if let Some(n) = l.step_iterations
+                && !(1..=1_000_000_000).contains(&n)
+            {
+                return Err(invalid(
+                    "loading.step_iterations",
+                    format!("must be in 1..=1000000000, got {n}"),
                 ));
             }
             for (field, v) in [
@@ -740,6 +834,17 @@ impl Scene {
             for o in &c.obstacles {
                 for v in o {
                     finite("contact.obstacles", *v)?;
+                    // their directions are normalised differences
+                    if v.abs() > MAX_POSITION {
+                        return Err(invalid(
+                            "contact.obstacles",
+                            format!(
+                                "each coordinate must be within ±{} rod lengths, got {}",
+                                short(MAX_POSITION),
+                                short(*v)
+                            ),
+                        ));
+                    }
                 }
             }
         }
@@ -762,7 +867,7 @@ impl Scene {
             // the writhe's far-loop terms lose every digit past this
             return Err(invalid(
                 "diagnostics.ray_length",
-                format!("must be <= 1e12, got {}", d.ray_length),
+                format!("must be <= 1e12, got {}", short(d.ray_length)),
             ));
         }
         match crate::geometry::knot::alexander_of(&d.knot) {
@@ -815,7 +920,10 @@ fn reachable(fields: [&'static str; 2], c: &Clamps) -> Result<(), SceneError> {
         finite(fields[0], z_star)?;
         finite(fields[1], delta)?;
         if delta < 0.0 {
-            return Err(invalid(fields[1], format!("δ must be >= 0, got {delta}")));
+            return Err(invalid(
+                fields[1],
+                format!("δ must be >= 0, got {}", short(delta)),
+            ));
         }
         // a free end has no point to reach
         let span = c.span();
@@ -823,7 +931,8 @@ fn reachable(fields: [&'static str; 2], c: &Clamps) -> Result<(), SceneError> {
             return Err(invalid(
                 fields[0],
                 format!(
-                    "the clamps are farther apart than the rod's length: |r(1) − r(0)| = {span} > 1"
+                    "the clamps are farther apart than the rod's length: |r(1) − r(0)| = {} > 1",
+                    short(span)
                 ),
             ));
         }
@@ -832,20 +941,28 @@ fn reachable(fields: [&'static str; 2], c: &Clamps) -> Result<(), SceneError> {
     finite(fields[0], z_star)?;
     finite(fields[1], delta)?;
     if delta < 0.0 {
-        return Err(invalid(fields[1], format!("δ must be >= 0, got {delta}")));
+        return Err(invalid(
+            fields[1],
+            format!("δ must be >= 0, got {}", short(delta)),
+        ));
     }
     if z_star.abs() > 1.0 {
         return Err(invalid(
             fields[0],
-            format!("|z*| must be <= 1 (the rod has length 1), got {z_star}"),
+            format!(
+                "|z*| must be <= 1 (the rod has length 1), got {}",
+                short(z_star)
+            ),
         ));
     }
-    if (z_star * z_star + delta * delta).sqrt() > 1.0 {
+    if z_star.hypot(delta) > 1.0 {
         return Err(invalid(
             fields[1],
             format!(
-                "the clamps are farther apart than the rod's length: sqrt(z*² + δ²) = {} > 1 (z* = {z_star}, δ = {delta})",
-                (z_star * z_star + delta * delta).sqrt()
+                "the clamps are farther apart than the rod's length: sqrt(z*² + δ²) = {} > 1 (z* = {}, δ = {})",
+                short(z_star.hypot(delta)),
+                short(z_star),
+                short(delta)
             ),
         ));
     }

@@ -10,9 +10,9 @@ use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::rod::{Clamps, RodState};
 use crate::scene::LoadingSpec;
 use crate::solve::minimizer::Minimizer;
-use crate::solve::outcome::SolverSettings;
+use crate::solve::outcome::{SolveError, SolveReport, SolverSettings};
 use crate::study::branch::Observer;
-use crate::study::error::{Context, Result, fail};
+use crate::study::error::{Context, Result, StudyError, fail};
 
 /// A step is a jump when the minimiser lands farther than this (rod lengths)
 /// from the first-order prediction (and than half the predicted move).
@@ -40,14 +40,86 @@ fn inertia(newton: &mut Minimizer, state: &RodState, want_mode: bool) -> Result<
     ))
 }
 
+/// The Newton iterations a loading step may still take
+/// (`loading.step_iterations`), spent by every solve of the step: its move,
+/// the escapes from saddles, the bisections that locate a jump, a wall or a
+/// lost contact. A path that cannot settle stops with an error naming the
+/// step instead of running on.
+pub struct Allowance {
+    left: usize,
+    budget: usize,
+}
+
+impl Allowance {
+    /// `budget` iterations.
+    pub fn new(budget: usize) -> Self {
+        Allowance {
+            left: budget,
+            budget,
+        }
+    }
+
+    /// No budget beyond each solve's own `max_iterations`.
+    pub fn unlimited() -> Self {
+        Allowance::new(usize::MAX)
+    }
+
+    /// Minimise from `state` with at most the iterations left.
+    fn minimize(
+        &mut self,
+        newton: &mut Minimizer,
+        state: &mut RodState,
+        settings: &SolverSettings,
+    ) -> Result<SolveReport> {
+        if self.left == 0 {
+            return Err(self.spent());
+        }
+        let capped = settings.max_iterations > self.left;
+        let within = SolverSettings {
+            max_iterations: settings.max_iterations.min(self.left),
+            ..*settings
+        };
+        match newton.minimize(state, &within) {
+            Ok(r) => {
+                self.left -= r.iterations.min(self.left);
+                Ok(r)
+            }
+            Err(SolveError::NotConverged { .. }) if capped => {
+                self.left = 0;
+                Err(self.spent())
+            }
+            Err(e) => Err(e.into()),
+        }
+    }
+
+    fn spent(&self) -> StudyError {
+        StudyError::Failed(format!(
+            "the step ran out of its budget of {} Newton iterations (loading.step_iterations, \
+             default {} × solver.max_iterations) without settling",
+            self.budget,
+            LoadingSpec::DEFAULT_STEP_BUDGET
+        ))
+    }
+}
+
 /// Minimise from `state` and make sure the result is a minimum: from a saddle,
 /// step off along the unstable mode (both ways tried, the lower energy kept).
 pub fn minimize_to_stable(
     newton: &mut Minimizer,
     state: &mut RodState,
     settings: &SolverSettings,
-) -> Result<crate::solve::outcome::SolveReport> {
-    let mut report = newton.minimize(state, settings)?;
+) -> Result<SolveReport> {
+    settle(newton, state, settings, &mut Allowance::unlimited())
+}
+
+/// [`minimize_to_stable`] within `allowance`.
+fn settle(
+    newton: &mut Minimizer,
+    state: &mut RodState,
+    settings: &SolverSettings,
+    allowance: &mut Allowance,
+) -> Result<SolveReport> {
+    let mut report = allowance.minimize(newton, state, settings)?;
     for _ in 0..=8 {
         // held by contacts, it is a minimum of the constrained problem (its
         // stability is judged on the contacts' tangent space by `analyse`)
@@ -66,11 +138,11 @@ pub fn minimize_to_stable(
         if largest == 0.0 {
             fail!("saddle with no translational unstable mode");
         }
-        let mut best: Option<(f64, RodState, crate::solve::outcome::SolveReport)> = None;
+        let mut best: Option<(f64, RodState, SolveReport)> = None;
         for sign in [1.0, -1.0] {
             let kick: Vec<f64> = mode.iter().map(|x| sign * 1e-3 * x / largest).collect();
             let mut trial = state.displaced(&map, &kick);
-            let r = newton.minimize(&mut trial, settings)?;
+            let r = allowance.minimize(newton, &mut trial, settings)?;
             if best.as_ref().is_none_or(|b| r.energy < b.0) {
                 best = Some((r.energy, trial, r));
             }
@@ -124,7 +196,7 @@ pub struct Step {
     /// The settled state.
     pub state: RodState,
     /// How the minimiser got there.
-    pub report: crate::solve::outcome::SolveReport,
+    pub report: SolveReport,
     /// Distance from the first-order prediction.
     pub miss: f64,
     /// Whether it landed far from the prediction.
@@ -140,10 +212,21 @@ pub fn move_clamps(
     c: Clamps,
     settings: &SolverSettings,
 ) -> Result<Step> {
+    move_within(newton, state, c, settings, &mut Allowance::unlimited())
+}
+
+/// [`move_clamps`] within `allowance`.
+fn move_within(
+    newton: &mut Minimizer,
+    state: &RodState,
+    c: Clamps,
+    settings: &SolverSettings,
+    allowance: &mut Allowance,
+) -> Result<Step> {
     let predicted = predict(newton, state, c)?;
     let predicted_move = predicted.largest_node_distance(state);
     let mut next = predicted.clone();
-    let report = minimize_to_stable(newton, &mut next, settings)?;
+    let report = settle(newton, &mut next, settings, allowance)?;
     let miss = next.largest_node_distance(&predicted);
     Ok(Step {
         state: next,
@@ -158,6 +241,7 @@ pub fn move_clamps(
 /// holds and the first clamps where it fails.
 fn locate_on_path(
     newton: &mut Minimizer,
+    allowance: &mut Allowance,
     from: &RodState,
     to: Clamps,
     settings: &SolverSettings,
@@ -166,7 +250,7 @@ fn locate_on_path(
     let (mut lo, mut hi) = (from.clone(), to);
     while lo.clamps.gap(&hi) > JUMP_LOCATION {
         let mid = lo.clamps.midpoint(&hi);
-        let trial = move_clamps(newton, &lo, mid, settings)?;
+        let trial = move_within(newton, &lo, mid, settings, allowance)?;
         if same(newton, &trial)? {
             lo = trial.state;
         } else {
@@ -207,6 +291,7 @@ pub fn run_loading(
         settings,
         measure,
         events: Vec::new(),
+        allowance: Allowance::unlimited(),
     };
     for (leg, stage) in path.iter().enumerate() {
         let c0 = state.clamps;
@@ -223,6 +308,7 @@ pub fn run_loading(
         }
         let steps = stage.steps as usize;
         for k in 1..=steps {
+            hand.allowance = Allowance::new(stage.step_budget(settings));
             let f = k as f64 / steps as f64;
             let c = c0.lerp(&target, f);
             let at = Leg {
@@ -253,6 +339,8 @@ struct Hand<'n> {
     settings: &'n SolverSettings,
     measure: &'n Measure,
     events: Vec<Event>,
+    /// What is left of the current step's iteration budget.
+    allowance: Allowance,
 }
 
 /// One step of a loading path: from the equilibrium `eq` (state `from`) to
@@ -276,8 +364,8 @@ impl Hand<'_> {
     /// (see [`Hand::follow_jump`]).
     fn advance(&mut self, at: &Leg) -> Result<(Step, Equilibrium)> {
         let (newton, measure) = (&mut *self.newton, self.measure);
-        let step =
-            move_clamps(newton, at.from, at.to, self.settings).with_context(|| at.context())?;
+        let step = move_within(newton, at.from, at.to, self.settings, &mut self.allowance)
+            .with_context(|| at.context())?;
         let next = analyse_from(
             newton,
             &step.state,
@@ -303,19 +391,28 @@ impl Hand<'_> {
     ) -> Result<(Step, Equilibrium)> {
         let (settings, measure) = (self.settings, self.measure);
         let mut lo_eq = at.eq.clone();
-        let (lo_state, hi) = locate_on_path(self.newton, at.from, at.to, settings, &mut |nw, t| {
-            let t_eq = analyse_from(nw, &t.state, &t.report, measure, Some(&lo_eq), None)?;
-            let same = !t.jumped && link_jump(&lo_eq, &t_eq).abs() <= JUMP_LINK;
-            if same {
-                lo_eq = t_eq;
-            }
-            Ok(same)
-        })
+        let allowance = &mut self.allowance;
+        let (lo_state, hi) = locate_on_path(
+            self.newton,
+            allowance,
+            at.from,
+            at.to,
+            settings,
+            &mut |nw, t| {
+                let t_eq = analyse_from(nw, &t.state, &t.report, measure, Some(&lo_eq), None)?;
+                let same = !t.jumped && link_jump(&lo_eq, &t_eq).abs() <= JUMP_LINK;
+                if same {
+                    lo_eq = t_eq;
+                }
+                Ok(same)
+            },
+        )
         .with_context(|| at.context())?;
         // the last step from the end of the branch jumps; the rod then
         // moves on from where it landed to this step's clamps
         let newton = &mut *self.newton;
-        let landed = move_clamps(newton, &lo_state, hi, settings).with_context(|| at.context())?;
+        let landed = move_within(newton, &lo_state, hi, settings, allowance)
+            .with_context(|| at.context())?;
         let landed_eq = analyse_from(
             newton,
             &landed.state,
@@ -343,8 +440,8 @@ impl Hand<'_> {
                 landed.miss, lo_eq.link, landed_eq.link, lo_eq.twist, landed_eq.twist
             ),
         ));
-        let step =
-            move_clamps(newton, &landed.state, at.to, settings).with_context(|| at.context())?;
+        let step = move_within(newton, &landed.state, at.to, settings, allowance)
+            .with_context(|| at.context())?;
         let next = analyse_from(
             newton,
             &step.state,
@@ -360,9 +457,14 @@ impl Hand<'_> {
     fn locate_wall(&mut self, at: &Leg) -> Result<()> {
         let inside = at.eq.walled;
         let width = self.measure.strip_width;
-        let (_, hi) = locate_on_path(self.newton, at.from, at.to, self.settings, &mut |_, t| {
-            Ok(walls(&t.state, width).walled == inside)
-        })
+        let (_, hi) = locate_on_path(
+            self.newton,
+            &mut self.allowance,
+            at.from,
+            at.to,
+            self.settings,
+            &mut |_, t| Ok(walls(&t.state, width).walled == inside),
+        )
         .with_context(|| at.context())?;
         let detail = if inside {
             "leaves the walls"
@@ -381,9 +483,14 @@ impl Hand<'_> {
 
     /// The last contact opens: locate where its force reaches zero.
     fn locate_contact_loss(&mut self, at: &Leg) -> Result<()> {
-        let (_, hi) = locate_on_path(self.newton, at.from, at.to, self.settings, &mut |_, t| {
-            Ok(!t.report.contacts.is_empty())
-        })
+        let (_, hi) = locate_on_path(
+            self.newton,
+            &mut self.allowance,
+            at.from,
+            at.to,
+            self.settings,
+            &mut |_, t| Ok(!t.report.contacts.is_empty()),
+        )
         .with_context(|| at.context())?;
         let names: Vec<&str> = at.eq.contacts.iter().map(|c| c.obstacle.as_str()).collect();
         let detail = format!(
