@@ -47,9 +47,16 @@ fn cross2(a: Vector2<f64>, b: Vector2<f64>) -> f64 {
 }
 
 /// Relative size of the margins that make a projection degenerate: crossings
-/// this close (in segment parameter) to a vertex or to each other, strands
-/// this close (relative to the curve's size) in depth.
+/// this close (in segment parameter) to a vertex or to each other, segments
+/// this close to parallel.
 pub(crate) const MARGIN: f64 = 1e-10;
+
+/// Relative depth below which two strands at a crossing are taken to meet
+/// (the curve then has no knot type): well above the depths' rounding, about
+/// 10ε of the curve's size, which is all that can flip over and under; a
+/// 10⁶-point noisy curve has strands within 10⁻¹⁰ of each other in depth at
+/// some crossing in every direction, and they do not meet.
+pub(crate) const DEPTH_MARGIN: f64 = 1e-13;
 
 /// A closed polygon projected along a direction.
 pub(crate) struct Projection {
@@ -150,7 +157,7 @@ impl Projection {
                 if j == i + 1 || (i == 0 && j == m - 1) {
                     continue;
                 }
-                if let Some(c) = crossing(&self.p2, &self.depth, i, j, self.scale)? {
+                if let Some(c) = self.crossing(i, j)? {
                     visit(c)?;
                 }
             }
@@ -183,62 +190,59 @@ pub(super) fn crossings(
     Ok(out)
 }
 
-/// The crossing of projected segments i < j, if any.
-fn crossing(
-    p2: &[Vector2<f64>],
-    depth: &[f64],
-    i: usize,
-    j: usize,
-    scale: f64,
-) -> Result<Option<Crossing>, Degenerate> {
-    let m = p2.len();
-    let (p, r) = (p2[i], p2[(i + 1) % m] - p2[i]);
-    let (q, s) = (p2[j], p2[(j + 1) % m] - p2[j]);
-    let (lo_i, hi_i) = (p.inf(&(p + r)), p.sup(&(p + r)));
-    let (lo_j, hi_j) = (q.inf(&(q + s)), q.sup(&(q + s)));
-    let pad = MARGIN * scale;
-    if lo_i.x > hi_j.x + pad
-        || lo_j.x > hi_i.x + pad
-        || lo_i.y > hi_j.y + pad
-        || lo_j.y > hi_i.y + pad
-    {
-        return Ok(None);
-    }
-    let denom = cross2(r, s);
-    let qp = q - p;
-    if denom.abs() <= MARGIN * r.norm() * s.norm() {
-        // parallel in projection: degenerate only if they (nearly) overlap
-        if cross2(qp, r).abs() <= MARGIN * r.norm() * scale {
+impl Projection {
+    /// The crossing of projected segments i < j, if any.
+    fn crossing(&self, i: usize, j: usize) -> Result<Option<Crossing>, Degenerate> {
+        let (p2, depth, scale) = (&self.p2, &self.depth, self.scale);
+        let m = p2.len();
+        let (p, r) = (p2[i], p2[(i + 1) % m] - p2[i]);
+        let (q, s) = (p2[j], p2[(j + 1) % m] - p2[j]);
+        let (lo_i, hi_i) = (p.inf(&(p + r)), p.sup(&(p + r)));
+        let (lo_j, hi_j) = (q.inf(&(q + s)), q.sup(&(q + s)));
+        let pad = MARGIN * scale;
+        if lo_i.x > hi_j.x + pad
+            || lo_j.x > hi_i.x + pad
+            || lo_i.y > hi_j.y + pad
+            || lo_j.y > hi_i.y + pad
+        {
+            return Ok(None);
+        }
+        let denom = cross2(r, s);
+        let qp = q - p;
+        if denom.abs() <= MARGIN * r.norm() * s.norm() {
+            // parallel in projection: degenerate only if they (nearly) overlap
+            if cross2(qp, r).abs() <= MARGIN * r.norm() * scale {
+                return Err(Degenerate::Projection);
+            }
+            return Ok(None);
+        }
+        let t = cross2(qp, s) / denom;
+        let u = cross2(qp, r) / denom;
+        let eps = MARGIN;
+        if t < -eps || t > 1.0 + eps || u < -eps || u > 1.0 + eps {
+            return Ok(None);
+        }
+        let (t, u) = (t.clamp(0.0, 1.0), u.clamp(0.0, 1.0));
+        let di = depth[i] + t * (depth[(i + 1) % m] - depth[i]);
+        let dj = depth[j] + u * (depth[(j + 1) % m] - depth[j]);
+        if (di - dj).abs() <= DEPTH_MARGIN * scale {
+            let at = p + t * r;
+            return Err(Degenerate::SelfIntersection(Vector3::new(at.x, at.y, di)));
+        }
+        if t < eps || t > 1.0 - eps || u < eps || u > 1.0 - eps {
             return Err(Degenerate::Projection);
         }
-        return Ok(None);
+        let (over, under, d_over, d_under) = if di > dj {
+            ((i, t), (j, u), r, s)
+        } else {
+            ((j, u), (i, t), s, r)
+        };
+        Ok(Some(Crossing {
+            over,
+            under,
+            positive: cross2(d_over, d_under) > 0.0,
+        }))
     }
-    let t = cross2(qp, s) / denom;
-    let u = cross2(qp, r) / denom;
-    let eps = MARGIN;
-    if t < -eps || t > 1.0 + eps || u < -eps || u > 1.0 + eps {
-        return Ok(None);
-    }
-    let (t, u) = (t.clamp(0.0, 1.0), u.clamp(0.0, 1.0));
-    let di = depth[i] + t * (depth[(i + 1) % m] - depth[i]);
-    let dj = depth[j] + u * (depth[(j + 1) % m] - depth[j]);
-    if (di - dj).abs() <= MARGIN * scale {
-        let at = p + t * r;
-        return Err(Degenerate::SelfIntersection(Vector3::new(at.x, at.y, di)));
-    }
-    if t < eps || t > 1.0 - eps || u < eps || u > 1.0 - eps {
-        return Err(Degenerate::Projection);
-    }
-    let (over, under, d_over, d_under) = if di > dj {
-        ((i, t), (j, u), r, s)
-    } else {
-        ((j, u), (i, t), s, r)
-    };
-    Ok(Some(Crossing {
-        over,
-        under,
-        positive: cross2(d_over, d_under) > 0.0,
-    }))
 }
 
 /// A knot diagram by its Gauss code: the crossings met along the curve, each
