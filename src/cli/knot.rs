@@ -1,8 +1,8 @@
 //! `knotrod knot`: writhe and knot type of any curve.
 
 use crate::geometry::closure::{extent, ray_closure};
-use crate::geometry::knot::{KnotError, KnotType, knot_type};
-use crate::geometry::writhe::writhe_closed;
+use crate::geometry::knot::{KnotError, KnotType, knot_type, unit_sized};
+use crate::geometry::writhe::try_writhe_closed;
 use crate::io::curve_file::read_points;
 use crate::io::json::write_pretty;
 use anyhow::{Context, Result};
@@ -23,6 +23,7 @@ pub enum RayKind {
 pub fn knot(path: &Path, closed: bool, rays: RayKind, json: Option<PathBuf>) -> Result<()> {
     let points = read_points(path)?;
     let (writhe, kt) = writhe_and_knot(&points, closed, rays);
+    let writhe = writhe.with_context(|| format!("writhe of {}", path.display()))?;
     let kt = kt.with_context(|| format!("knot type of {}", path.display()))?;
     let answer = serde_json::json!({
         "curve": path.display().to_string(),
@@ -59,26 +60,29 @@ pub fn knot(path: &Path, closed: bool, rays: RayKind, json: Option<PathBuf>) -> 
 }
 
 /// Writhe and knot type of a closed curve, or of an open one closed by rays.
+/// Both are unchanged by moving and scaling the curve, so it is first brought
+/// to unit size: the rays' lengths cannot overflow.
 fn writhe_and_knot(
     points: &[Vector3<f64>],
     closed: bool,
     rays: RayKind,
-) -> (f64, Result<KnotType, KnotError>) {
+) -> (Result<f64, KnotError>, Result<KnotType, KnotError>) {
+    let points = unit_sized(points);
     if closed {
-        return (writhe_closed(points), knot_type(points));
+        return (try_writhe_closed(&points), knot_type(&points));
     }
     let m = points.len();
     let (bottom, top) = match rays {
         RayKind::Tangent => (points[0] - points[1], points[m - 1] - points[m - 2]),
         RayKind::Z => (-Vector3::z(), Vector3::z()),
     };
-    let size = extent(points).max(1e-300);
+    let size = extent(&points);
     // writhe error of the closure decays as 1/(ray length)
-    let w = writhe_closed(&ray_closure(points, bottom, top, 1e6 * size));
+    let w = try_writhe_closed(&ray_closure(&points, bottom, top, 1e6 * size));
     (
         w,
         knot_type(&ray_closure(
-            points,
+            &points,
             bottom,
             top,
             2.0 * size + size.max(1.0),

@@ -50,8 +50,9 @@ pub fn parse_points(text: &str) -> Result<Vec<Vector3<f64>>, CurveError> {
             Err(e) => return Err(bad(e.to_string())),
         }
     }
-    // drop repeated consecutive points, which have no direction
-    points.dedup_by(|a, b| (*a - *b).norm() == 0.0);
+    // drop repeated consecutive points, which have no direction (compared
+    // exactly: the norm of a difference of 1e-300 underflows to 0)
+    points.dedup();
     if points.len() < 3 {
         return Err(CurveError::TooShort(points.len()));
     }

@@ -8,7 +8,7 @@
 //! Δ(1) = +1). The determinant of the knot is |Δ(−1)|. Names come from the
 //! table of prime knots up to 10 crossings (KnotInfo) and their sums.
 
-mod diagram;
+pub(crate) mod diagram;
 mod modular;
 mod names;
 mod simplify;
@@ -68,9 +68,31 @@ pub enum KnotError {
         "the curve's diagram keeps {0} crossings after simplification (at most {MAX_CROSSINGS} are resolved): it is too tangled to identify"
     )]
     TooManyCrossings(usize),
+    /// The projection's sweep would test more segment pairs than it may: the
+    /// count, and the seconds it would take.
+    #[error(
+        "the curve's projection has {pairs:.2e} pairs of overlapping segments to test, about {seconds:.0} s (at most {:.0e} are tested): it is too tangled to identify",
+        diagram::MOST_PAIRS as f64
+    )]
+    TooLong {
+        /// Pairs of segments the sweep would test.
+        pairs: f64,
+        /// Estimated seconds.
+        seconds: f64,
+    },
     /// A coefficient of the Alexander polynomial does not fit in 64 bits.
     #[error("the Alexander polynomial has a coefficient beyond 64 bits")]
     Overflow,
+}
+
+impl KnotError {
+    /// The error for a sweep of `pairs` segment pairs, with its estimate.
+    pub(crate) fn too_long(pairs: u64) -> KnotError {
+        KnotError::TooLong {
+            pairs: pairs as f64,
+            seconds: pairs as f64 / diagram::PAIRS_PER_SECOND,
+        }
+    }
 }
 
 /// Largest reduced diagram whose polynomial is computed: the cost grows as
@@ -96,16 +118,62 @@ pub fn projection_directions(count: usize) -> Vec<Vector3<f64>> {
         .collect()
 }
 
+/// 2^e as a pair of factors, each a normal f64, whose product is 2^e (one
+/// power of two alone covers only e in −1022…1023).
+fn power_of_two(e: i32) -> [f64; 2] {
+    let half = e / 2;
+    [2f64.powi(half), 2f64.powi(e - half)]
+}
+
+/// Exponent e with 2^(e−1) ≤ x < 2^(e+1) for a positive finite x, from
+/// log2, which neither overflows nor underflows (subnormals included).
+fn binary_exponent(x: f64) -> i32 {
+    x.log2().floor() as i32 + 1
+}
+
+/// `points` scaled by a power of two so that the largest absolute coordinate
+/// is near 1; exact, since scaling by 2^e only changes exponents.
+fn scaled_to_unit(points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+    let largest = points.iter().map(|p| p.amax()).fold(0.0, f64::max);
+    if largest == 0.0 {
+        return points.to_vec();
+    }
+    let [f, g] = power_of_two(-binary_exponent(largest));
+    points.iter().map(|p| (p * f) * g).collect()
+}
+
+/// The curve moved and scaled to unit size: its bounding box centred at the
+/// origin, its largest coordinate between ½ and 2. Knot type and writhe do
+/// not change, and every margin and tolerance downstream is relative to a
+/// curve of size 1, so a curve at 10⁻³⁰⁰ or 10³⁰⁰ is read as at 1 (without
+/// it, products of coordinates overflow or underflow). The first scaling
+/// (before the centre is taken, so that lo + hi cannot overflow) and the
+/// second are powers of two; only the translation rounds. The points must
+/// be finite.
+pub fn unit_sized(points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+    if points.is_empty() {
+        return Vec::new();
+    }
+    let mut p = scaled_to_unit(points);
+    let lo = p.iter().fold(p[0], |m, q| m.inf(q));
+    let hi = p.iter().fold(p[0], |m, q| m.sup(q));
+    let centre = (lo + hi) / 2.0;
+    for q in &mut p {
+        *q -= centre;
+    }
+    scaled_to_unit(&p)
+}
+
 /// The polygon without repeated consecutive points (the last point may
-/// repeat the first), checked finite.
-fn distinct_points(closed: &[Vector3<f64>]) -> Result<Vec<Vector3<f64>>, KnotError> {
+/// repeat the first), checked finite, at unit size ([`unit_sized`]).
+pub(crate) fn distinct_points(closed: &[Vector3<f64>]) -> Result<Vec<Vector3<f64>>, KnotError> {
     if let Some(i) = closed.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
         return Err(KnotError::NotFinite(i));
     }
     let mut out: Vec<Vector3<f64>> = Vec::with_capacity(closed.len());
-    for p in closed {
-        if out.last() != Some(p) {
-            out.push(*p);
+    for p in unit_sized(closed) {
+        if out.last() != Some(&p) {
+            out.push(p);
         }
     }
     while out.len() > 1 && out.first() == out.last() {
@@ -151,6 +219,7 @@ fn along(points: &[Vector3<f64>], dir: &Vector3<f64>) -> Result<KnotType, Option
         Degenerate::Projection => None,
         Degenerate::SelfIntersection(at) => Some(KnotError::SelfIntersection(at)),
         Degenerate::TooMany(n) => Some(KnotError::TooManyCrossings(n)),
+        Degenerate::TooMuchWork(pairs) => Some(KnotError::too_long(pairs)),
     };
     let crossings = diagram::crossings(points, dir).map_err(degenerate)?;
     let mut diagram = Diagram::new(&crossings).map_err(degenerate)?;

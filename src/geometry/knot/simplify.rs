@@ -7,14 +7,18 @@
 //!
 //! Candidates come from a hash grid of segment bounding boxes, rebuilt each
 //! pass at the current median segment length, so a pass costs O(n) for a
-//! curve of bounded local density.
+//! curve of bounded local density; each pass removes a fixed fraction of the
+//! vertices of a dense curve (three quarters of a noisy one), so the passes
+//! together cost O(n) too (plus O(n) for each pass that removes little).
 
 use nalgebra::Vector3;
-use rustc_hash::FxHashMap;
 
 /// Segments whose boxes span more cells than this are kept in a list that
 /// every query scans (the long closing rays, the far loop).
 const LARGE: i64 = 64;
+
+/// End of a bucket's list.
+const NONE: u32 = u32::MAX;
 
 type Cell = (i32, i32, i32);
 
@@ -27,21 +31,36 @@ struct Cycle<'a> {
     alive: usize,
 }
 
+/// A spatial hash of segment boxes: cells of size h hashed into a table of
+/// buckets, each a linked list of entries in one pool, so filing and
+/// unfiling allocate nothing per cell. Cells that share a bucket only add
+/// candidates, which the exact tests reject.
 struct Grid {
     origin: Vector3<f64>,
     h: f64,
-    cells: FxHashMap<Cell, Vec<u32>>,
+    /// First entry of each bucket.
+    heads: Vec<u32>,
+    /// Bits of the bucket index.
+    bits: u32,
+    /// (segment, next entry of its bucket).
+    entries: Vec<(u32, u32)>,
     large: Vec<u32>,
     /// Cell range of each filed segment; None for large or unfiled ones.
     range: Vec<Option<(Cell, Cell)>>,
 }
 
 impl Grid {
-    fn new(origin: Vector3<f64>, h: f64, n: usize) -> Grid {
+    /// A grid for `live` segments named 0..n.
+    fn new(origin: Vector3<f64>, h: f64, n: usize, live: usize) -> Grid {
+        // about 4 buckets per segment: a segment spans ~8 cells, each
+        // bucket then holds about two entries
+        let bits = (4 * live.max(16)).next_power_of_two().trailing_zeros();
         Grid {
             origin,
             h,
-            cells: FxHashMap::default(),
+            heads: vec![NONE; 1 << bits],
+            bits,
+            entries: Vec::with_capacity(8 * live),
             large: Vec::new(),
             range: vec![None; n],
         }
@@ -52,8 +71,21 @@ impl Grid {
         (c.x.floor() as i32, c.y.floor() as i32, c.z.floor() as i32)
     }
 
+    fn bucket(&self, (i, j, k): Cell) -> usize {
+        let key = (i as u32 as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (j as u32 as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+            ^ (k as u32 as u64).wrapping_mul(0x1656_67B1_9E37_79F9);
+        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize
+    }
+
     fn span(lo: Cell, hi: Cell) -> i64 {
         (hi.0 - lo.0 + 1) as i64 * (hi.1 - lo.1 + 1) as i64 * (hi.2 - lo.2 + 1) as i64
+    }
+
+    fn cells(lo: Cell, hi: Cell) -> impl Iterator<Item = Cell> {
+        (lo.0..=hi.0).flat_map(move |i| {
+            (lo.1..=hi.1).flat_map(move |j| (lo.2..=hi.2).map(move |k| (i, j, k)))
+        })
     }
 
     fn insert(&mut self, id: usize, a: &Vector3<f64>, b: &Vector3<f64>) {
@@ -63,12 +95,10 @@ impl Grid {
             self.range[id] = None;
             return;
         }
-        for i in lo.0..=hi.0 {
-            for j in lo.1..=hi.1 {
-                for k in lo.2..=hi.2 {
-                    self.cells.entry((i, j, k)).or_default().push(id as u32);
-                }
-            }
+        for c in Self::cells(lo, hi) {
+            let at = self.bucket(c);
+            self.entries.push((id as u32, self.heads[at]));
+            self.heads[at] = (self.entries.len() - 1) as u32;
         }
         self.range[id] = Some((lo, hi));
     }
@@ -77,15 +107,21 @@ impl Grid {
         match self.range[id].take() {
             None => self.large.retain(|&s| s as usize != id),
             Some((lo, hi)) => {
-                for i in lo.0..=hi.0 {
-                    for j in lo.1..=hi.1 {
-                        for k in lo.2..=hi.2 {
-                            if let Some(v) = self.cells.get_mut(&(i, j, k))
-                                && let Some(at) = v.iter().position(|&s| s as usize == id)
-                            {
-                                v.swap_remove(at);
-                            }
-                        }
+                // one entry per cell: unlink one from each cell's bucket
+                for c in Self::cells(lo, hi) {
+                    let at = self.bucket(c);
+                    let (mut prev, mut e) = (NONE, self.heads[at]);
+                    while e != NONE && self.entries[e as usize].0 as usize != id {
+                        (prev, e) = (e, self.entries[e as usize].1);
+                    }
+                    if e == NONE {
+                        continue;
+                    }
+                    let after = self.entries[e as usize].1;
+                    if prev == NONE {
+                        self.heads[at] = after;
+                    } else {
+                        self.entries[prev as usize].1 = after;
                     }
                 }
             }
@@ -93,7 +129,7 @@ impl Grid {
     }
 
     /// Segments whose boxes may meet the box [lo, hi], into `out` (with
-    /// repeats); None when the box spans more cells than there are segments
+    /// repeats); false when the box spans more cells than there are segments
     /// (the caller then scans them all).
     fn near(&self, lo: &Vector3<f64>, hi: &Vector3<f64>, live: usize, out: &mut Vec<u32>) -> bool {
         let (a, b) = (self.cell(lo), self.cell(hi));
@@ -102,13 +138,12 @@ impl Grid {
         if Self::span(a, b) > live as i64 {
             return false;
         }
-        for i in a.0..=b.0 {
-            for j in a.1..=b.1 {
-                for k in a.2..=b.2 {
-                    if let Some(v) = self.cells.get(&(i, j, k)) {
-                        out.extend_from_slice(v);
-                    }
-                }
+        for c in Self::cells(a, b) {
+            let mut e = self.heads[self.bucket(c)];
+            while e != NONE {
+                let (s, next) = self.entries[e as usize];
+                out.push(s);
+                e = next;
             }
         }
         true
@@ -276,10 +311,11 @@ pub(super) fn simplify(points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
             .iter()
             .map(|&v| (cyc.p[cyc.next[v]] - cyc.p[v]).norm())
             .collect();
-        lengths.sort_by(f64::total_cmp);
+        let half = lengths.len() / 2;
+        let (_, median, _) = lengths.select_nth_unstable_by(half, f64::total_cmp);
         // cells no finer than 2⁻²⁰ of the curve, so cell indices fit in i32
-        let h = (coarsen * lengths[lengths.len() / 2]).max(size * 2f64.powi(-20));
-        let mut grid = Grid::new(lo - Vector3::repeat(2.0 * h), h, n);
+        let h = (coarsen * *median).max(size * 2f64.powi(-20));
+        let mut grid = Grid::new(lo - Vector3::repeat(2.0 * h), h, n, order.len());
         for &v in &order {
             grid.insert(v, &cyc.p[v], &cyc.p[cyc.next[v]]);
         }
