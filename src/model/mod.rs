@@ -8,6 +8,7 @@ pub mod continuum;
 pub mod continuum_branch;
 pub mod energy;
 pub mod frames;
+pub mod hessian_form;
 pub mod natural;
 pub mod ode;
 pub mod rod;
