@@ -17,6 +17,7 @@ mod islands;
 mod loading;
 mod paper;
 mod runs;
+mod stiff;
 mod strip;
 
 pub use convergence::{continuum_reference, convergence_table};
@@ -51,5 +52,6 @@ pub fn report(scenes: &Path) -> Result<String> {
     s += &contact::section(scenes)?;
     s += &general::section(scenes)?;
     s += &convergence::sections(&d)?;
+    s += &stiff::section(&d)?;
     Ok(s)
 }
