@@ -500,3 +500,47 @@ fn parameter_derivative_with_pinned_ends_matches_finite_differences() {
     parameter_derivative_of_the_gradient(Law::Kirchhoff, with_ends(Clamped, Pinned));
     parameter_derivative_of_the_gradient(Law::Kirchhoff, with_ends(Pinned, Clamped));
 }
+
+#[test]
+fn hessian_gram_matches_the_assembled_form() {
+    // the stencil-by-stencil form zₚᵀ H z_q of the stability refinement is
+    // the assembled Hessian's, at every kind of end and for a constrained law
+    use EndKind::{Clamped, Free, Pinned};
+    let cases = [
+        (Clamped, Clamped, Law::Kirchhoff),
+        (Clamped, Free, Law::Kirchhoff),
+        (Pinned, Clamped, Law::Kirchhoff),
+        (Free, Pinned, Law::Kirchhoff),
+        (Clamped, Clamped, Law::Unbendable),
+    ];
+    for (seed, (start, end, law)) in cases.into_iter().enumerate() {
+        let (model, state) = random_state_at(12, 7 + seed as u64, law, with_ends(start, end));
+        let energy = RodEnergy::with_ends(model, Terms::ALL, state.clamps.ends);
+        let n = energy.map.len();
+        let mut g = vec![0.0; n];
+        let mut vals = vec![0.0; energy.pattern.nnz()];
+        energy.hessian(&state, &mut g, &mut vals);
+        let h = energy.pattern.to_dense(&vals);
+        let mut rng = Lcg(seed as u64);
+        let z: Vec<Vec<f64>> = (0..3)
+            .map(|_| (0..n).map(|_| rng.next()).collect())
+            .collect();
+        let gram = energy.hessian_gram(&state, &z);
+        let habs = h.abs();
+        for p in 0..3 {
+            for q in 0..3 {
+                let (zp, zq) = (
+                    nalgebra::DVector::from_column_slice(&z[p]),
+                    nalgebra::DVector::from_column_slice(&z[q]),
+                );
+                let exact = zp.dot(&(&h * &zq));
+                let scale = zp.abs().dot(&(&habs * zq.abs()));
+                assert!(
+                    (gram[p * 3 + q] - exact).abs() < 1e-12 * scale,
+                    "{start:?}-{end:?} {law:?} ({p}, {q}): gram {} assembled {exact}",
+                    gram[p * 3 + q]
+                );
+            }
+        }
+    }
+}

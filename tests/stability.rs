@@ -125,3 +125,66 @@ fn unstable_state_spectrum_matches_dense() {
         check(&RodEnergy::new(model), &st, true);
     }
 }
+
+/// Appendix D at N segments and stretching stiffness `s`, Newton-polished
+/// (a few plain steps, the least |∇E| kept: the study's stopping test may
+/// stop above the gradient's floor) and measured: its lowest ω².
+fn stiff_omega2(n: usize, s: f64) -> f64 {
+    use knotrod::analysis::equilibrium::analyse;
+    let mut scene =
+        knotrod::scene::Scene::load(std::path::Path::new("scenes/appendix_d.toml")).expect("scene");
+    scene.model.stretching_stiffness = Some(s);
+    let (mut newton, mut state, report) =
+        knotrod::study::start::starting_equilibrium(&scene, Some(n)).expect("equilibrium");
+    let energy = newton.energy.clone();
+    let mut g = vec![0.0; energy.map.len()];
+    let mut v = vec![0.0; energy.pattern.nnz()];
+    let gradient = |st: &RodState, g: &mut [f64], v: &mut [f64]| {
+        energy.hessian(st, g, v);
+        g.iter().map(|x| x * x).sum::<f64>().sqrt()
+    };
+    let (mut best, mut best_state) = (gradient(&state, &mut g, &mut v), state.clone());
+    for _ in 0..5 {
+        newton.ldlt.factor(&v).expect("factor");
+        g.iter_mut().for_each(|x| *x = -*x);
+        newton.ldlt.solve_in_place(&mut g);
+        state = state.displaced(&energy.map, &g);
+        let now = gradient(&state, &mut g, &mut v);
+        if now < best {
+            (best, best_state) = (now, state.clone());
+        }
+    }
+    let eq = analyse(&mut newton, &best_state, &report, &scene.measure()).expect("analyse");
+    eq.omega_squared[0]
+}
+
+#[test]
+fn stiff_rod_keeps_the_lowest_omega2() {
+    // ω² is smooth in 1/S (a finite stiffness's model error); the quadratic
+    // in 1/S through S = 1e5, 2e5, 4e5, where the assembled Hessian still
+    // holds ω² to ~1e-8, predicts S = 1e8 to ~2e-9 at the same N. Shift-invert
+    // on the assembled matrices alone is off by ε S/h²/ω² ≈ 5e-7 there.
+    let n = 800;
+    let trend: Vec<(f64, f64)> = [1e5, 2e5, 4e5]
+        .iter()
+        .map(|&s| (1.0 / s, stiff_omega2(n, s)))
+        .collect();
+    let at = |x: f64| -> f64 {
+        (0..3)
+            .map(|i| {
+                trend[i].1
+                    * (0..3)
+                        .filter(|&j| j != i)
+                        .map(|j| (x - trend[j].0) / (trend[i].0 - trend[j].0))
+                        .product::<f64>()
+            })
+            .sum()
+    };
+    let s = 1e8;
+    let (omega2, predicted) = (stiff_omega2(n, s), at(1.0 / s));
+    let rel = ((omega2 - predicted) / predicted).abs();
+    assert!(
+        rel < 5e-8,
+        "N = {n}, S = {s:e}: ω² = {omega2:.10}, the S-trend {predicted:.10} (relative {rel:.1e})"
+    );
+}

@@ -10,8 +10,10 @@ use crate::geometry::knot::{KnotType, knot_names};
 use crate::geometry::ribbon::Ribbon;
 use crate::geometry::walls::wall_clearance_between;
 use crate::geometry::writhe::writhe_closed;
-use crate::linalg::eigen::lowest_eigenvalues;
-use crate::linalg::eigen::{Spectrum, StabilityError};
+use crate::linalg::eigen::{
+    Gram, Spectrum, StabilityError, lowest_eigenvalues, lowest_eigenvalues_refined,
+};
+use crate::linalg::sparse::Ldlt;
 use crate::model::contact_hessian::ContactHessian;
 use crate::model::energy::{RodEnergy, vertex_strains};
 use crate::model::rod::{Law, RodState};
@@ -501,19 +503,31 @@ fn stability(
     };
     let mut held = hold_contacts(newton, state, report, &values);
     let energy: &RodEnergy = &newton.energy;
-    let (pattern, values, ldlt) = match held.as_mut() {
-        Some(w) => (&w.pattern, &w.values, &mut w.ldlt),
-        None => (&energy.pattern, &values, &mut newton.ldlt),
+    // the rod's own Hessian form, stencil by stencil, refines the eigenpairs
+    // (a stiff rod's assembled matrix has lost the lowest ones' digits);
+    // with contacts held the widened matrix is all there is
+    let gram = |z: &[Vec<f64>]| energy.hessian_gram(state, z);
+    let (pattern, values, ldlt, form) = match held.as_mut() {
+        Some(w) => (&w.pattern, &w.values, &mut w.ldlt, None),
+        None => (
+            &energy.pattern,
+            &values,
+            &mut newton.ldlt,
+            Some(&gram as Gram<'_>),
+        ),
     };
-    let plain =
-        lowest_eigenvalues(pattern, values, None, k, ldlt).map_err(|source| AnalysisError {
-            step: "stability of the Hessian",
-            source,
-        })?;
+    let lowest = |mass: Option<&[f64]>, ldlt: &mut Ldlt| match form {
+        Some(gram) => lowest_eigenvalues_refined(pattern, values, mass, k, ldlt, gram),
+        None => lowest_eigenvalues(pattern, values, mass, k, ldlt),
+    };
+    let plain = lowest(None, ldlt).map_err(|source| AnalysisError {
+        step: "stability of the Hessian",
+        source,
+    })?;
     // with no eigenvalues asked the inertia is all, and the pencil adds nothing
     let pencil_values = if k > 0 {
         let mass = energy.lumped_mass();
-        lowest_eigenvalues(pattern, values, Some(&mass), k, ldlt)
+        lowest(Some(&mass), ldlt)
             .map_err(|source| AnalysisError {
                 step: "stability with the lumped mass",
                 source,

@@ -708,7 +708,7 @@ impl RodEnergy {
 
     /// Energy, gradient and Hessian of vertex i in its 8 variables
     /// (e_{i-1}, e_i, θ_{i-1}, θ_i).
-    fn vertex_hessian8(
+    pub(crate) fn vertex_hessian8(
         &self,
         state: &RodState,
         i: usize,

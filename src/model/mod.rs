@@ -9,6 +9,7 @@ pub mod continuum_branch;
 pub mod continuum_stability;
 pub mod energy;
 pub mod frames;
+pub mod hessian_form;
 pub mod natural;
 pub mod ode;
 pub mod rod;

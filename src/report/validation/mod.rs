@@ -18,6 +18,7 @@ mod loading;
 mod paper;
 mod roundoff;
 mod runs;
+mod stiff;
 mod strip;
 
 pub use convergence::{continuum_reference, convergence_table};
@@ -53,5 +54,6 @@ pub fn report(scenes: &Path) -> Result<String> {
     s += &contact::section(scenes)?;
     s += &general::section(scenes)?;
     s += &convergence::sections(&d)?;
+    s += &stiff::section(&d)?;
     Ok(s)
 }
