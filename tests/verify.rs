@@ -387,7 +387,7 @@ fn duplicate_underflowing_and_lawless_fields_are_refused_by_row_and_field() {
         let message = e.to_string();
         assert!(
             matches!(e, VerifyFileError::Field { .. })
-                && message.contains(&format!("{row}"))
+                && message.contains(row)
                 && message.contains(&format!(": {field}: "))
                 && message.contains(why),
             "case {k}: {message}"
