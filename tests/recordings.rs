@@ -219,8 +219,9 @@ fn interrupted_run_leaves_a_finalised_recording() {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    // wait for a few streamed equilibria, then Ctrl-C
-    let lines = dir.join("run.jsonl");
+    // wait for a few streamed equilibria (in the stream's temporary file
+    // until the run ends), then Ctrl-C
+    let lines = dir.join("run.jsonl.tmp");
     let start = std::time::Instant::now();
     while std::fs::read_to_string(&lines).map_or(0, |t| t.lines().count()) < 5 {
         assert!(
@@ -253,6 +254,12 @@ fn interrupted_run_leaves_a_finalised_recording() {
         summary["equilibria"].as_array().unwrap().len(),
         r.scalars.len()
     );
+    // and so does the stream, renamed into place; no temporary file is left
+    let streamed = std::fs::read_to_string(dir.join("run.jsonl")).unwrap();
+    assert_eq!(streamed.lines().count(), r.scalars.len());
+    for f in ["run.jsonl.tmp", "run.mcap.tmp", "run.json.tmp"] {
+        assert!(!dir.join(f).exists(), "{f} left behind");
+    }
 }
 
 #[test]

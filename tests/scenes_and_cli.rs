@@ -498,3 +498,29 @@ fn bad_general_clamps_and_model_parameters_name_the_field() {
         );
     }
 }
+
+/// Issue 31, item 11: two refusals of a strip's clamps carried 18 spaces (a
+/// literal broken over lines without its `\`); every refusal reads as prose
+/// (the fuzz targets check the same on every refused scene).
+#[test]
+fn refusals_of_a_strip_s_start_clamp_read_without_runs_of_spaces() {
+    let strip = "[model]\nkind = \"strip\"\nsegments = 40\n[clamps]\nz_star = 0.215\n\
+                 delta = 0.05\nphi_over_2pi = 0.94\n";
+    let start = "[clamps.start]\nposition = [0.0, 0.0, 0.1]\n";
+    for (text, field) in [
+        (
+            strip.replace("segments = 40", "segments = 40\nstrip_width = 0.01") + start,
+            "model.strip_width",
+        ),
+        (
+            format!(
+                "{strip}{start}[initial]\nshape = \"shooting\"\nn0 = [0.0, 0.0, 1.0]\nu1_0 = 1.0\nm2_0 = 0.0\nu3_0 = 0.0\n"
+            ),
+            "clamps.start",
+        ),
+    ] {
+        let e = error_of(&text);
+        assert!(e.contains(field), "{e}");
+        knotrod::io::fuzz::one_spaced(&e);
+    }
+}

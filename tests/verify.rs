@@ -279,3 +279,187 @@ fn every_shipped_file_of_solutions_reads() {
     }
     assert!(count >= 5, "{count} files");
 }
+
+/// Issue 31, item 9: a field given twice (JSON keeps both, a CSV has two
+/// columns of one name, or n0 beside n0_1), a literal whose digits underflow,
+/// and a stiffness the law has not (K2 or K3 on a strip) are refused, naming
+/// the row and the field, instead of one silently winning or a rounding of
+/// 0/0 written as null.
+#[test]
+fn duplicate_underflowing_and_lawless_fields_are_refused_by_row_and_field() {
+    let dir = common::temp_dir("verify-dup");
+    let rod = std::fs::canonicalize("scenes/appendix_d.toml").unwrap();
+    let strip = std::fs::canonicalize("scenes/fig8_strip_knot.toml").unwrap();
+    let json_head = format!(
+        "{{\"scene\": {:?}, \"solution\": [",
+        rod.display().to_string()
+    );
+    let cases: Vec<(&str, String, &str, &str, &str)> = vec![
+        (
+            "json",
+            format!(
+                "{json_head}{{\"n0\": [1.0, 2.0, 3.0], \"m0\": [7.5317, -8.7100, 4.529], \
+                 \"n0\": [-24.743, 17.772, 37.145]}}]}}"
+            ),
+            "solution 1",
+            "n0",
+            "given twice",
+        ),
+        (
+            "csv",
+            "n0_1,n0_2,n0_3,m0_1,m0_2,m0_3,n0_1\n\
+             -24.743,17.772,37.145,7.5317,-8.7100,4.529,1.0\n"
+                .to_string(),
+            "header",
+            "n0_1",
+            "two columns",
+        ),
+        (
+            "toml",
+            format!(
+                "scene = {:?}\n[[solution]]\nn0 = [-24.743, 17.772, 37.145]\n\
+                 n0_2 = 17.772\nm0 = [7.5317, -8.7100, 4.529]\n",
+                rod.display().to_string()
+            ),
+            "solution 1",
+            "n0_2",
+            "given twice",
+        ),
+        (
+            "toml",
+            format!(
+                "scene = {:?}\n[[solution]]\nn0 = [-24.743e-400, 17.772, 37.145]\n\
+                 m0 = [7.5317, -8.7100, 4.529]\n",
+                rod.display().to_string()
+            ),
+            "solution 1",
+            "n0",
+            "underflows",
+        ),
+        (
+            "json",
+            format!(
+                "{json_head}{{\"n0\": [-24.743, 17.772, 37.145], \
+                 \"m0\": [7.5317, -8.7100, 4.529], \"energy\": 1.5e-320}}]}}"
+            ),
+            "solution 1",
+            "energy",
+            "underflows",
+        ),
+        (
+            "csv",
+            "n0_1,n0_2,n0_3,m0_1,m0_2,m0_3,phi_over_2pi\n\
+             -24.743,17.772,37.145,7.5317,-8.7100,4.529,0.8e-99999999999\n"
+                .to_string(),
+            "line 2",
+            "phi_over_2pi",
+            "underflows",
+        ),
+        (
+            "toml",
+            format!(
+                "scene = {:?}\n[[solution]]\nn0 = [-8.43069, 1.60824, 72.0790]\n\
+                 u1_0 = 7.65134\nm2_0 = -4.23332\nu3_0 = 0.0816504\nK2 = 2.0\n",
+                strip.display().to_string()
+            ),
+            "solution 1",
+            "K2",
+            "no K2",
+        ),
+        (
+            "toml",
+            format!(
+                "scene = {:?}\n[[solution]]\nn0 = [-8.43069, 1.60824, 72.0790]\n\
+                 u1_0 = 7.65134\nm2_0 = -4.23332\nu3_0 = 0.0816504\nK3 = 2.0\n",
+                strip.display().to_string()
+            ),
+            "solution 1",
+            "K3",
+            "no K3",
+        ),
+    ];
+    for (k, (ext, text, row, field, why)) in cases.iter().enumerate() {
+        let path = dir.join(format!("case{k}.{ext}"));
+        std::fs::write(&path, text).unwrap();
+        let e = read_solutions(&path, ext.eq(&"csv").then_some(&*rod))
+            .map(|(_, s)| format!("accepted: {:?}", s[0].unknowns))
+            .unwrap_err();
+        let message = e.to_string();
+        assert!(
+            matches!(e, VerifyFileError::Field { .. })
+                && message.contains(row)
+                && message.contains(&format!(": {field}: "))
+                && message.contains(why),
+            "case {k}: {message}"
+        );
+    }
+    // the good rows these were made from read
+    let good = dir.join("good.json");
+    std::fs::write(
+        &good,
+        format!(
+            "{json_head}{{\"n0\": [-24.743, 17.772, 37.145], \"m0\": [7.5317, -8.7100, 4.529], \
+             \"energy\": 0.0}}]}}"
+        ),
+    )
+    .unwrap();
+    read_solutions(&good, None).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Issue 31, item 9: a verify run is held to the base scene's `[budget]`,
+/// checked before any work, the error naming the option that drives it;
+/// `--threads` beyond the machine's cores is capped, not obeyed.
+#[test]
+fn a_verify_run_past_the_budget_is_refused_up_front_naming_the_option() {
+    let dir = common::temp_dir("verify-budget");
+    // 20 000 rows of the heavy knot's solution
+    let text = std::fs::read_to_string("scenes/verify/heavy_knot.toml").unwrap();
+    let (head, row) = text.split_once("[[solution]]").unwrap();
+    let scene = std::fs::canonicalize("scenes/verify").unwrap();
+    let head = head.replace("scene = \"", &format!("scene = \"{}/", scene.display()));
+    let many = dir.join("many.toml");
+    let mut all = head.clone();
+    for _ in 0..20_000 {
+        all += "[[solution]]";
+        all += row;
+    }
+    std::fs::write(&many, all).unwrap();
+    let one = dir.join("one.toml");
+    std::fs::write(&one, format!("{head}[[solution]]{row}")).unwrap();
+    let four = dir.join("four.toml");
+    std::fs::write(
+        &four,
+        format!("{head}{}", format!("[[solution]]{row}").repeat(4)),
+    )
+    .unwrap();
+    let (many, one, four) = (
+        many.to_str().unwrap(),
+        one.to_str().unwrap(),
+        four.to_str().unwrap(),
+    );
+    let start = std::time::Instant::now();
+    for (args, says) in [
+        // about 5000 s predicted (0.25 s a row, as measured) against 1 h
+        (vec![many, "--segments", "200,400,800"], "20000 solutions"),
+        // about 19 min a row at these N (`run`'s rates): four rows are past 1 h
+        (vec![four, "--segments", "25000,50000,100000"], "--segments"),
+    ] {
+        let out = common::knotrod(&[&["verify"], &args[..]].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{err}");
+        assert!(
+            err.contains(says) && err.contains("budget") && err.contains("--allow-large"),
+            "{err}"
+        );
+    }
+    // refused before the work: both answers took far less than one solve
+    assert!(start.elapsed().as_secs() < 60, "{:?}", start.elapsed());
+    // 10⁵ threads are capped at the cores (the run completes; it would not
+    // start 10⁵ threads' stacks)
+    let out = common::knotrod(&["verify", one, "--threads", "100000"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("--threads 100000: capped at"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

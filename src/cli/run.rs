@@ -5,7 +5,7 @@
 use super::progress::Progress;
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
-use crate::io::json::create_parent;
+use crate::io::output::Output;
 use crate::io::plot::{PlotPoint, bifurcation_diagram};
 use crate::io::recording::Recorder;
 use crate::io::summary::{Summary, print_equilibrium, print_events};
@@ -13,8 +13,7 @@ use crate::model::rod::RodModel;
 use crate::scene::{Job, Scene};
 use crate::study::error::StudyError;
 use crate::study::run::run_scene;
-use anyhow::{Context, Result};
-use std::fs::File;
+use anyhow::Result;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -78,24 +77,28 @@ pub fn run(
         }
         Err(e) => Some(e),
     };
-    // the recording and the summary are finalised whatever happened, with
-    // what was computed
-    outputs.finish(&summary.events, &mut out)?;
+    // the recording, the stream and the summary are finalised whatever
+    // happened, with what was computed
+    let summary_out = outputs.finish(&summary.events, &mut out)?;
     report(&scene, &summary, json.as_deref(), &mut out)?;
-    if let Some(path) = &json {
-        summary.write(path)?;
+    if let Some(file) = summary_out {
+        let path = file.path().to_path_buf();
+        summary.write(file)?;
         writeln!(out, "summary written to {}", path.display())?;
     }
     failed.map_or(Ok(()), |e| Err(e.into()))
 }
 
 /// Where a run's equilibria go as they are computed: one JSON line each to
-/// `<json>.jsonl`, and the MCAP recording.
+/// `<json>.jsonl`, and the MCAP recording; and the summary, written at the
+/// end. All are opened (and so held against a second run) before the work.
 struct Outputs {
-    /// The JSON lines stream and its file.
-    stream: Option<(BufWriter<File>, PathBuf)>,
+    /// The JSON lines stream.
+    stream: Option<BufWriter<Output>>,
     /// The recording.
     recorder: Option<Recorder>,
+    /// The summary's file.
+    summary: Option<Output>,
 }
 
 impl Outputs {
@@ -124,13 +127,11 @@ impl Outputs {
                     p.display(),
                     lines.display()
                 );
-                create_parent(p)?;
-                let file = File::create(&lines)
-                    .with_context(|| format!("creating {}", lines.display()))?;
-                Some((BufWriter::new(file), lines))
+                Some(BufWriter::new(Output::create(&lines)?))
             }
             None => None,
         };
+        let summary = json.map(Output::create).transpose()?;
         let recorder = match record {
             Some(file) => {
                 let file = file.unwrap_or_else(|| {
@@ -156,18 +157,22 @@ impl Outputs {
             }
             None => None,
         };
-        Ok(Outputs { stream, recorder })
+        Ok(Outputs {
+            stream,
+            recorder,
+            summary,
+        })
     }
 
     /// Stream one equilibrium (the line is flushed at once).
     fn equilibrium(&mut self, eq: &Equilibrium) -> Result<()> {
-        if let Some((w, lines)) = self.stream.as_mut() {
-            let write = |w: &mut BufWriter<File>| -> std::io::Result<()> {
+        if let Some(w) = self.stream.as_mut() {
+            let write = |w: &mut BufWriter<Output>| -> std::io::Result<()> {
                 serde_json::to_writer(&mut *w, eq)?;
                 w.write_all(b"\n")?;
                 w.flush()
             };
-            write(w).with_context(|| format!("writing {}", lines.display()))?;
+            write(w).map_err(|e| w.get_ref().error("writing", e))?;
         }
         if let Some(r) = self.recorder.as_mut() {
             r.record(eq)?;
@@ -175,19 +180,30 @@ impl Outputs {
         Ok(())
     }
 
-    /// Record the events, finalise the recording and say where it is.
-    fn finish(self, events: &[Event], out: &mut impl Write) -> Result<()> {
+    /// Finalise the stream, record the events, finalise the recording and
+    /// say where it is; hand back the summary's file.
+    fn finish(self, events: &[Event], out: &mut impl Write) -> Result<Option<Output>> {
+        if let Some(w) = self.stream {
+            w.into_inner()
+                .map_err(|e| {
+                    let (error, w) = e.into_parts();
+                    w.get_ref().error("writing", error)
+                })?
+                .commit()?;
+        }
         if let Some(mut r) = self.recorder {
-            r.events(events)?;
+            let recorded = r.events(events);
             let (file, states) = (r.path().to_path_buf(), r.len());
+            // finished even when the events failed: a failure is finish's to tell
             r.finish()?;
+            recorded?;
             writeln!(
                 out,
                 "recording written to {} ({states} states)",
                 file.display()
             )?;
         }
-        Ok(())
+        Ok(self.summary)
     }
 }
 
@@ -222,7 +238,6 @@ fn report(
     let stem = json
         .map(Path::to_path_buf)
         .unwrap_or_else(|| PathBuf::from("recordings").join(scene.file_stem("run")));
-    create_parent(&stem)?;
     let title = format!("{} (N = {})", summary.scene, summary.segments);
     let points: Vec<PlotPoint> = summary.equilibria.iter().map(PlotPoint::from).collect();
     for f in bifurcation_diagram(&stem, &title, &points, &summary.events)? {

@@ -8,6 +8,7 @@ use crate::io::json::write_pretty;
 use crate::io::verify_file::read_solutions;
 use crate::model::rod::Parameter;
 use crate::report::verify::{details, markdown, summary};
+use crate::scene::{InitialShape, Job, Scene, human_time};
 use crate::study::verify::{Quantity, SolutionCheck, VerifyOptions, verify_all};
 use anyhow::{Context, Result, bail, ensure};
 use std::io::Write;
@@ -39,9 +40,68 @@ pub struct Args {
     /// Write a markdown report here (with a convergence plot beside it).
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Threads (default: all cores); results are the same for any count.
+    /// Threads (default: all cores; at most the machine's cores); results
+    /// are the same for any count.
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Verify even when the predicted memory or CPU time exceeds the base
+    /// scene's `[budget]`.
+    #[arg(long)]
+    pub allow_large: bool,
+}
+
+/// The machine's cores.
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Refuse (unless `allow_large`) a verify run whose predicted CPU time or
+/// memory exceeds the base scene's `[budget]`, the limits `run` uses: each
+/// solution is one equilibrium at each of the three N, its memory held by
+/// each of `threads` solves at once. The error names the option to change.
+fn check_budget(
+    base: &Scene,
+    solutions: usize,
+    segments: [usize; 3],
+    threads: usize,
+    allow_large: bool,
+) -> Result<()> {
+    if allow_large {
+        return Ok(());
+    }
+    // one shooting start per N: the base scene's path of equilibria is not followed
+    let mut one = base.clone();
+    one.continuation = None;
+    one.sweep = None;
+    one.loading.clear();
+    one.initial.shape = InitialShape::Shooting;
+    let seconds: f64 = segments
+        .iter()
+        .map(|&n| one.estimate(Job::Run, Some(n)).seconds)
+        .sum::<f64>()
+        * solutions as f64;
+    // no more solves at once than solutions
+    let at_once = threads.min(solutions).max(1);
+    let memory = one.estimate(Job::Run, Some(segments[2])).memory_bytes * at_once as f64;
+    let [n1, n2, n3] = segments;
+    let b = &base.budget;
+    ensure!(
+        seconds <= b.hours * 3600.0,
+        "predicted CPU time {} ({solutions} solutions × N = {n1}, {n2}, {n3} of --segments) \
+         exceeds the budget of {}: give fewer solutions or smaller --segments, raise \
+         `budget.hours` in the base scene, or pass --allow-large",
+        human_time(seconds),
+        human_time(b.hours * 3600.0)
+    );
+    ensure!(
+        memory <= b.memory_gb * 1e9,
+        "predicted memory {:.3} GB ({at_once} solves at once, of --threads, each at \
+         N = {n3} of --segments) exceeds the budget of {} GB: use fewer --threads or smaller \
+         --segments, raise `budget.memory_gb` in the base scene, or pass --allow-large",
+        memory / 1e9,
+        b.memory_gb
+    );
+    Ok(())
 }
 
 fn parameter(name: &str) -> Result<Parameter> {
@@ -79,6 +139,18 @@ pub fn verify(a: Args) -> Result<()> {
         ..VerifyOptions::default()
     };
     let (base, solutions) = read_solutions(&a.file, a.scene.as_deref())?;
+    // more threads than cores only cost memory (and 10⁵ threads cost the machine)
+    let threads = a.threads.map_or(cores(), |t| t.clamp(1, cores()));
+    if let Some(t) = a.threads.filter(|t| *t > threads) {
+        eprintln!("--threads {t}: capped at the machine's {threads} cores");
+    }
+    check_budget(
+        &base,
+        solutions.len(),
+        options.segments,
+        threads,
+        a.allow_large,
+    )?;
     let progress = Progress::bar(solutions.len() as u64, "solutions");
     let run = || {
         verify_all(&base, &solutions, &options, &|c: &SolutionCheck| {
@@ -87,8 +159,8 @@ pub fn verify(a: Args) -> Result<()> {
         })
     };
     let checks = match a.threads {
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t.max(1))
+        Some(_) => rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
             .build()
             .context("--threads: the thread pool")?
             .install(run)?,
@@ -131,8 +203,7 @@ pub fn verify(a: Args) -> Result<()> {
             options.segments,
             drawn.then_some(name.as_str()),
         );
-        crate::io::json::create_parent(p)?;
-        std::fs::write(p, text).with_context(|| format!("writing {}", p.display()))?;
+        crate::io::output::write_file(p, text.as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())

@@ -95,8 +95,5 @@ pub fn convergence_plot(path: &Path, series: &[Series]) -> Result<()> {
     if !crate::io::plot::font_available() {
         return Err(IoError::Plot("no font to draw the labels with".into()));
     }
-    draw(
-        SVGBackend::new(path, (900, 600)).into_drawing_area(),
-        series,
-    )
+    crate::io::plot::write_svg(path, (900, 600), |root| draw(root, series))
 }

@@ -47,6 +47,23 @@ pub enum IoError {
         /// What is wrong.
         reason: String,
     },
+    /// The device holding a file is full: the file was not replaced.
+    #[error(
+        "no space left on device: {} not written (a file already there is left as it was)",
+        path.display()
+    )]
+    NoSpace {
+        /// The file being written.
+        path: PathBuf,
+    },
+    /// A file cannot be written: it is a folder, or another writer holds it.
+    #[error("{}: {why}", path.display())]
+    Refused {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        why: String,
+    },
     /// Drawing a plot failed.
     #[error("plot: {0}")]
     Plot(String),

@@ -85,7 +85,7 @@ pub fn export(path: &Path, index: u64, format: ExportFormat, out: Option<&Path>)
         ExportFormat::Shooting => shooting(&msg, path, index)?,
     };
     match out {
-        Some(p) => std::fs::write(p, text).map_err(IoError::file("writing", p)),
+        Some(p) => crate::io::output::write_file(p, text.as_bytes()),
         None => std::io::stdout()
             .lock()
             .write_all(text.as_bytes())

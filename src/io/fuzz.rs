@@ -5,7 +5,7 @@
 use crate::geometry::knot::knot_type;
 use crate::geometry::polyline::parse_points;
 use crate::io::recording::{parse_recording, parse_state};
-use crate::scene::{Job, Scene};
+use crate::scene::{Job, Scene, SceneError};
 use nalgebra::Vector3;
 use std::path::Path;
 
@@ -13,19 +13,36 @@ use std::path::Path;
 /// the knot code itself has its own limits).
 const MOST_POINTS: usize = 2000;
 
-/// A scene's text: parsed and validated, and its budget estimated.
+/// A scene's text: parsed and validated, and its budget estimated. The
+/// messages of its refusals read as prose ([`one_spaced`]).
 pub fn scene_text(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    if let Ok(scene) = Scene::parse(text) {
-        for job in [Job::Run, Job::Map] {
-            let e = scene.estimate(job, None);
-            assert!(e.memory_bytes >= 0.0 && e.seconds >= 0.0, "estimate {e:?}");
-            let _ = scene.check_budget(job, None, false);
+    match Scene::parse(text) {
+        Ok(scene) => {
+            for job in [Job::Run, Job::Map] {
+                let e = scene.estimate(job, None);
+                assert!(e.memory_bytes >= 0.0 && e.seconds >= 0.0, "estimate {e:?}");
+                if let Err(e) = scene.check_budget(job, None, false) {
+                    one_spaced(&e.to_string());
+                }
+            }
+            let _ = scene.file_stem("fuzz");
         }
-        let _ = scene.file_stem("fuzz");
+        // the parser's errors quote the input, which may hold any spacing
+        Err(e @ SceneError::Invalid { .. }) => one_spaced(&e.to_string()),
+        Err(_) => {}
     }
+}
+
+/// No run of two or more spaces inside a line of an error message: the
+/// indentation of a string literal broken over lines without its `\`.
+pub fn one_spaced(message: &str) {
+    assert!(
+        !message.lines().any(|l| l.trim().contains("  ")),
+        "a run of spaces in the message {message:?}"
+    );
 }
 
 /// A curve file's text: parsed, and its knot type found (closed).

@@ -1,26 +1,23 @@
 //! JSON files: pretty JSON and a final newline, written atomically.
 
 use crate::io::error::{IoError, Result};
+use crate::io::output::Output;
 use serde::Serialize;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Write `value` to `path` as pretty JSON followed by a newline, creating the
-/// parent folder. The text goes to `path.tmp` first and is renamed into place,
-/// so a reader never sees a half-written file.
+/// parent folder, atomically and refusing a second writer
+/// ([`crate::io::output::Output`]).
 pub fn write_pretty<T: Serialize + ?Sized>(path: &Path, value: &T) -> Result<()> {
-    let text = serde_json::to_string_pretty(value)
-        .map_err(IoError::json("cannot encode as JSON", path))?;
-    create_parent(path)?;
-    let tmp = tmp_path(path);
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(text.as_bytes())?;
-        f.write_all(b"\n")?;
-        f.sync_all()
-    };
-    write().map_err(IoError::file("writing", &tmp))?;
-    std::fs::rename(&tmp, path).map_err(IoError::file("writing", path))
+    write_pretty_to(Output::create(path)?, value)
+}
+
+/// `write_pretty` to an output opened (and so reserved) earlier.
+pub fn write_pretty_to<T: Serialize + ?Sized>(out: Output, value: &T) -> Result<()> {
+    let mut text = serde_json::to_string_pretty(value)
+        .map_err(IoError::json("cannot encode as JSON", out.path()))?;
+    text.push('\n');
+    out.put(text.as_bytes())
 }
 
 /// Create the folder holding `path` (if it names one).
@@ -29,11 +26,4 @@ pub fn create_parent(path: &Path) -> Result<()> {
         Some(dir) => std::fs::create_dir_all(dir).map_err(IoError::file("creating folder", dir)),
         None => Ok(()),
     }
-}
-
-/// `path` with ".tmp" appended to its file name.
-fn tmp_path(path: &Path) -> PathBuf {
-    let mut s = path.as_os_str().to_os_string();
-    s.push(".tmp");
-    PathBuf::from(s)
 }

@@ -35,6 +35,9 @@ pub enum MapFileError {
         #[source]
         source: serde_json::Error,
     },
+    /// A file could not be written (full disk, another writer).
+    #[error(transparent)]
+    Write(Box<crate::io::IoError>),
     /// Shards do not make a whole map.
     #[error("{0}")]
     Merge(String),
@@ -51,12 +54,9 @@ fn file_error(what: &'static str, path: &Path) -> impl FnOnce(std::io::Error) ->
     move |source| MapFileError::File { what, path, source }
 }
 
-/// Write `bytes` to `file` through a temporary file renamed into place, so a
-/// reader never sees half a file.
+/// Write `bytes` to `file` atomically ([`crate::io::output::Output`]).
 fn write_atomically(file: &Path, bytes: &[u8]) -> Result<(), MapFileError> {
-    let tmp = file.with_extension("json.tmp");
-    std::fs::write(&tmp, bytes).map_err(file_error("writing", &tmp))?;
-    std::fs::rename(&tmp, file).map_err(file_error("writing", file))
+    crate::io::output::write_file(file, bytes).map_err(|e| MapFileError::Write(Box::new(e)))
 }
 
 /// The lines of a map kept as `line_KKKKK.json` in a folder, each with the
@@ -73,19 +73,24 @@ struct KeptLine {
     line: Line,
 }
 
+/// The version of the sources that compute a line: a hash of their contents
+/// made by build.rs (not the package version, which a rebuild keeps).
+pub const SOURCE_VERSION: &str = env!("KNOTROD_SOURCE_HASH");
+
 /// What determines a map's lines and walk: the whole scene after defaults
 /// (model, start, solver, continuation, map), the map settings, N and the
-/// program's version.
+/// version of the sources that compute them (`source`).
 fn cache_key(
     scene: &Scene,
     spec: &MapSpec,
     segments: Option<usize>,
+    source: &str,
 ) -> Result<String, MapFileError> {
     Ok(serde_json::to_string(&(
         scene,
         spec,
         segments.unwrap_or(scene.model.segments as usize),
-        env!("CARGO_PKG_VERSION"),
+        source,
     ))?)
 }
 
@@ -99,10 +104,21 @@ impl LineFolder {
         spec: &MapSpec,
         segments: Option<usize>,
     ) -> Result<Self, MapFileError> {
+        Self::of_source(folder, scene, spec, segments, SOURCE_VERSION)
+    }
+
+    /// `create`, as the sources of version `source` would.
+    fn of_source(
+        folder: &Path,
+        scene: &Scene,
+        spec: &MapSpec,
+        segments: Option<usize>,
+        source: &str,
+    ) -> Result<Self, MapFileError> {
         std::fs::create_dir_all(folder).map_err(file_error("creating", folder))?;
         Ok(LineFolder {
             folder: folder.to_path_buf(),
-            key: cache_key(scene, spec, segments)?,
+            key: cache_key(scene, spec, segments, source)?,
         })
     }
 
@@ -126,8 +142,13 @@ impl LineStore for LineFolder {
             key: self.key.clone(),
             line: line.clone(),
         })?;
-        write_atomically(&self.file(line.index), &bytes)?;
-        Ok(())
+        match write_atomically(&self.file(line.index), &bytes) {
+            // another map of the same cache computes the same line
+            Err(MapFileError::Write(e)) if matches!(*e, crate::io::IoError::Refused { .. }) => {
+                Ok(())
+            }
+            r => Ok(r?),
+        }
     }
 }
 
@@ -148,7 +169,7 @@ pub fn trace_cached(
     }
     std::fs::create_dir_all(cache).map_err(file_error("creating", cache))?;
     let file = cache.join("trace.json");
-    let key = cache_key(scene, spec, segments)?;
+    let key = cache_key(scene, spec, segments, SOURCE_VERSION)?;
     if let Some(c) = std::fs::read_to_string(&file)
         .ok()
         .and_then(|t| serde_json::from_str::<Cached>(&t).ok())
@@ -222,4 +243,36 @@ pub fn merge(parts: &[PathBuf]) -> Result<Map, MapFileError> {
         )));
     }
     Ok(map)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A line kept by a build of other sources is recomputed, not resumed,
+    /// though the scene, the map settings, N and the package version agree.
+    #[test]
+    fn lines_of_another_build_are_not_resumed() {
+        let scene = Scene::load(Path::new("scenes/fig7_island_kirchhoff.toml")).unwrap();
+        let spec = scene.map.clone().unwrap();
+        let dir = std::env::temp_dir().join(format!("knotrod-cache-key-{}", std::process::id()));
+        let old = LineFolder::of_source(&dir, &scene, &spec, Some(20), "0000000000000000").unwrap();
+        let line = Line {
+            index: 3,
+            value: 0.5,
+            points: vec![],
+            events: vec![],
+            intervals: vec![],
+            error: None,
+        };
+        old.put(&line).unwrap();
+        assert!(old.get(3, 0.5).is_some(), "the same build resumes its line");
+        let new = LineFolder::create(&dir, &scene, &spec, Some(20)).unwrap();
+        assert!(
+            new.get(3, 0.5).is_none(),
+            "another build's line was resumed"
+        );
+        assert_eq!(SOURCE_VERSION.len(), 16);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -8,6 +8,7 @@ pub mod export;
 pub mod fuzz;
 pub mod json;
 pub mod map_files;
+pub mod output;
 pub mod plot;
 pub mod recording;
 pub mod scene_file;

@@ -8,9 +8,37 @@ use crate::analysis::class::Class;
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
 use crate::io::error::{IoError, Result};
+use crate::io::output::write_file;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
+
+/// Draw an SVG with `paint` in memory and write it to `path` atomically.
+pub(crate) fn write_svg(
+    path: &Path,
+    size: (u32, u32),
+    paint: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<()>,
+) -> Result<()> {
+    let mut text = String::new();
+    paint(SVGBackend::with_string(&mut text, size).into_drawing_area())?;
+    write_file(path, text.as_bytes())
+}
+
+/// Draw a PNG with `paint` in memory and write it to `path` atomically.
+fn write_png(
+    path: &Path,
+    size: (u32, u32),
+    paint: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<()>,
+) -> Result<()> {
+    use image::ImageEncoder;
+    let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
+    paint(BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area())?;
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(&pixels, size.0, size.1, image::ColorType::Rgb8)
+        .map_err(|e| IoError::Plot(format!("encoding {}: {e}", path.display())))?;
+    write_file(path, &png)
+}
 
 /// The colour of an equilibrium's class.
 pub fn class_colour(e: &Equilibrium) -> RGBColor {
@@ -262,21 +290,11 @@ pub fn bifurcation_diagram(
     let mut written = Vec::new();
     let fonts = font_available();
     let svg = stem.with_extension("svg");
-    draw(
-        SVGBackend::new(&svg, (900, 900)).into_drawing_area(),
-        title,
-        eqs,
-        events,
-    )?;
+    write_svg(&svg, (900, 900), |root| draw(root, title, eqs, events))?;
     written.push(svg);
     if fonts {
         let png = stem.with_extension("png");
-        draw(
-            BitMapBackend::new(&png, (900, 900)).into_drawing_area(),
-            title,
-            eqs,
-            events,
-        )?;
+        write_png(&png, (900, 900), |root| draw(root, title, eqs, events))?;
         written.push(png);
     }
     Ok(written)
@@ -289,14 +307,11 @@ pub fn island_map(stem: &Path, map: &crate::study::map::Map) -> Result<Vec<std::
     let mut written = Vec::new();
     let fonts = font_available();
     let svg = stem.with_extension("svg");
-    draw_map(SVGBackend::new(&svg, (900, 700)).into_drawing_area(), map)?;
+    write_svg(&svg, (900, 700), |root| draw_map(root, map))?;
     written.push(svg);
     if fonts {
         let png = stem.with_extension("png");
-        draw_map(
-            BitMapBackend::new(&png, (900, 700)).into_drawing_area(),
-            map,
-        )?;
+        write_png(&png, (900, 700), |root| draw_map(root, map))?;
         written.push(png);
     }
     Ok(written)
@@ -314,28 +329,31 @@ pub fn island_slices(
     let size = (450 * cols as u32, 380 * rows as u32);
     let mut written = Vec::new();
     let svg = stem.with_extension("svg");
-    {
-        let root = SVGBackend::new(&svg, size).into_drawing_area();
-        root.fill(&WHITE)
-            .map_err(|e| IoError::Plot(format!("{e:?}")))?;
-        for (area, m) in root.split_evenly((rows, cols)).into_iter().zip(&map.slices) {
-            draw_map(area, m)?;
-        }
-    }
+    write_svg(&svg, size, |root| draw_slices(root, map, (rows, cols)))?;
     written.push(svg);
     if font_available() {
         let png = stem.with_extension("png");
-        {
-            let root = BitMapBackend::new(&png, size).into_drawing_area();
-            root.fill(&WHITE)
-                .map_err(|e| IoError::Plot(format!("{e:?}")))?;
-            for (area, m) in root.split_evenly((rows, cols)).into_iter().zip(&map.slices) {
-                draw_map(area, m)?;
-            }
-        }
+        write_png(&png, size, |root| draw_slices(root, map, (rows, cols)))?;
         written.push(png);
     }
     Ok(written)
+}
+
+/// The slices of a 3D map in a grid of (rows, columns) panels.
+fn draw_slices<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    map: &crate::study::map::Map3,
+    grid: (usize, usize),
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e| IoError::Plot(format!("{e:?}"));
+    root.fill(&WHITE).map_err(err)?;
+    for (area, m) in root.split_evenly(grid).into_iter().zip(&map.slices) {
+        draw_map(area, m)?;
+    }
+    root.present().map_err(err)
 }
 
 /// A map axis's label: a parameter's name as the paper writes it where it

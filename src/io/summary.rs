@@ -7,7 +7,6 @@ use crate::model::rod::RodModel;
 use crate::scene::{ReferenceSpec, Scene};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
-use std::path::Path;
 
 /// The model as written in summaries.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -60,10 +59,11 @@ impl Summary {
         }
     }
 
-    /// Write as JSON (to a temporary file renamed into place, so a reader never
-    /// sees a half-written summary).
-    pub fn write(&self, path: &Path) -> crate::io::error::Result<()> {
-        crate::io::json::write_pretty(path, self)
+    /// Write as JSON to `out`, opened at the start of the run (a temporary
+    /// file renamed into place, so a reader never sees a half-written
+    /// summary, and a second run of the same file is refused at its start).
+    pub fn write(&self, out: crate::io::output::Output) -> crate::io::error::Result<()> {
+        crate::io::json::write_pretty_to(out, self)
     }
 }
 

@@ -78,14 +78,40 @@ enum Raw {
 
 /// Half a unit in the last digit of a decimal literal ("8.7100" → 5e-5,
 /// "-24.743" → 5e-4, "1.5e-3" → 5e-5, "12" → 0.5).
+/// An exponent past the range of doubles gives 0 or infinity, which
+/// [`usable`] refuses.
 pub fn half_unit(literal: &str) -> f64 {
     let t = literal.trim().replace('_', "").to_ascii_lowercase();
     let (mantissa, exponent) = match t.split_once('e') {
-        Some((m, e)) => (m.to_string(), e.parse::<i32>().unwrap_or(0)),
+        // clamped: past ±1000 the power is 0 or infinite either way
+        Some((m, e)) => (
+            m.to_string(),
+            e.parse::<i64>()
+                .unwrap_or(if e.starts_with('-') { -1000 } else { 1000 })
+                .clamp(-1000, 1000),
+        ),
         None => (t.clone(), 0),
     };
-    let decimals = mantissa.split_once('.').map_or(0, |(_, f)| f.len() as i32);
-    0.5 * 10f64.powi(exponent - decimals)
+    let decimals = mantissa.split_once('.').map_or(0, |(_, f)| f.len() as i64);
+    0.5 * 10f64.powi((exponent - decimals).clamp(-2000, 2000) as i32)
+}
+
+/// Why a number read with half-unit `u` cannot be used, if it cannot: it
+/// must be finite, and neither it nor its last digit may underflow (a value
+/// or a rounding below the smallest normal double, 2.2e-308, has lost its
+/// digits: its rounding units would be 0/0).
+fn usable(x: f64, u: f64) -> Result<(), String> {
+    if !x.is_finite() {
+        Err("a finite number".into())
+    } else if (x != 0.0 && !x.is_normal()) || !u.is_normal() {
+        Err(format!(
+            "the number underflows: it or its last digit is below {:e}, the smallest normal \
+             double, so its printed precision is lost",
+            f64::MIN_POSITIVE
+        ))
+    } else {
+        Ok(())
+    }
 }
 
 /// A decimal literal's value and half-unit (TOML's digit separators `_` are
@@ -196,29 +222,56 @@ fn json_raw(raw: &serde_json::value::RawValue) -> Option<Raw> {
     })
 }
 
+/// A JSON object's fields in the order written, a name given twice kept
+/// twice (a map would keep only the last).
+struct Fields(Vec<(String, Box<serde_json::value::RawValue>)>);
+
+impl<'de> serde::Deserialize<'de> for Fields {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = Fields;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an object")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut m: A) -> Result<Fields, A::Error> {
+                let mut fields = Vec::new();
+                while let Some(entry) = m.next_entry()? {
+                    fields.push(entry);
+                }
+                Ok(Fields(fields))
+            }
+        }
+        d.deserialize_map(Visit)
+    }
+}
+
 fn parse_json(path: &Path, text: &str) -> Result<(Option<String>, Vec<Row>), VerifyFileError> {
-    use serde_json::value::RawValue;
-    use std::collections::BTreeMap;
     let parse_error = |message: String| VerifyFileError::Parse {
         path: path.into(),
         message,
     };
     // each field is read as raw text, for its printed precision
-    let top: BTreeMap<String, Box<RawValue>> =
-        serde_json::from_str(text).map_err(|e| parse_error(e.to_string()))?;
+    let top: Fields = serde_json::from_str(text).map_err(|e| parse_error(e.to_string()))?;
     let mut scene = None;
-    let mut list: Vec<BTreeMap<String, Box<RawValue>>> = vec![];
-    for (key, value) in &top {
+    let mut list: Option<Vec<Fields>> = None;
+    for (key, value) in &top.0 {
         match key.as_str() {
+            "scene" if scene.is_some() => return Err(parse_error("scene is given twice".into())),
             "scene" => {
                 scene = Some(
                     serde_json::from_str::<String>(value.get())
                         .map_err(|_| parse_error("scene: a path (a string)".into()))?,
                 )
             }
+            "solution" if list.is_some() => {
+                return Err(parse_error("solution is given twice".into()));
+            }
             "solution" => {
-                list = serde_json::from_str(value.get())
-                    .map_err(|e| parse_error(format!("solution: a list of objects ({e})")))?
+                list = Some(
+                    serde_json::from_str(value.get())
+                        .map_err(|e| parse_error(format!("solution: a list of objects ({e})")))?,
+                )
             }
             other => {
                 return Err(parse_error(format!(
@@ -228,10 +281,10 @@ fn parse_json(path: &Path, text: &str) -> Result<(Option<String>, Vec<Row>), Ver
         }
     }
     let mut rows = Vec::new();
-    for (k, fields) in list.iter().enumerate() {
+    for (k, fields) in list.iter().flatten().enumerate() {
         let row = format!("solution {}", k + 1);
         let mut out = Vec::new();
-        for (name, value) in fields {
+        for (name, value) in &fields.0 {
             let raw = json_raw(value).ok_or_else(|| VerifyFileError::Field {
                 path: path.into(),
                 row: row.clone(),
@@ -260,6 +313,16 @@ fn parse_csv(path: &Path, text: &str) -> Result<(Option<String>, Vec<Row>), Veri
         .iter()
         .map(str::to_string)
         .collect();
+    for (k, name) in header.iter().enumerate() {
+        if header[..k].contains(name) {
+            return Err(VerifyFileError::Field {
+                path: path.into(),
+                row: "line 1 (the header)".into(),
+                field: name.clone(),
+                reason: "two columns have this name".into(),
+            });
+        }
+    }
     let mut rows = Vec::new();
     for record in reader.records() {
         let record = record.map_err(|e| parse_error(e.to_string()))?;
@@ -319,11 +382,11 @@ pub fn read_solutions(
         (None, None) => return Err(VerifyFileError::NoScene { path: path.into() }),
     };
     let base = Scene::load(&scene_path)?;
-    let strip = matches!(base.rod_model(None).law, Law::Strip { .. });
+    let law = base.rod_model(None).law;
     let solutions = rows
         .into_iter()
         .enumerate()
-        .map(|(k, (row, fields))| solution(path, k, &row, fields, strip))
+        .map(|(k, (row, fields))| solution(path, k, &row, fields, law))
         .collect::<Result<Vec<_>, _>>()?;
     if solutions.is_empty() {
         return Err(VerifyFileError::Parse {
@@ -339,8 +402,9 @@ fn solution(
     index: usize,
     row: &str,
     fields: Vec<(String, Raw)>,
-    strip: bool,
+    law: Law,
 ) -> Result<Solution, VerifyFileError> {
+    let strip = matches!(law, Law::Strip { .. });
     let bad = |field: &str, reason: String| VerifyFileError::Field {
         path: path.into(),
         row: row.into(),
@@ -351,10 +415,14 @@ fn solution(
     let mut parameters: Vec<(Parameter, f64)> = Vec::new();
     let mut parameter_rounding: Vec<f64> = Vec::new();
     let mut unknowns: [Option<(f64, f64)>; 6] = [None; 6];
+    // the field that set each unknown: one given twice (n0 and n0_1) is refused
+    let mut set_by: [Option<&str>; 6] = [None; 6];
     let mut claims = Claims::default();
     let finite = |field: &str, raw: &Raw| -> Result<(f64, f64), VerifyFileError> {
         match raw {
-            Raw::Number(x, u) if x.is_finite() => Ok((*x, *u)),
+            Raw::Number(x, u) => usable(*x, *u)
+                .map(|()| (*x, *u))
+                .map_err(|why| bad(field, why)),
             _ => Err(bad(field, "a finite number".into())),
         }
     };
@@ -374,27 +442,43 @@ fn solution(
     } else {
         &[]
     };
-    for (field, raw) in &fields {
+    for (k, (field, raw)) in fields.iter().enumerate() {
         let f = field.as_str();
-        let mut vector = |base: usize, f: &str| -> Result<(), VerifyFileError> {
-            match raw {
-                Raw::List(v) if v.len() == 3 && v.iter().all(|x| x.0.is_finite()) => {
-                    for c in 0..3 {
-                        unknowns[base + c] = Some(v[c]);
-                    }
-                    Ok(())
-                }
-                _ => Err(bad(f, "three finite numbers [x, y, z]".into())),
+        if fields[..k].iter().any(|(g, _)| g == f) {
+            return Err(bad(f, "given twice".into()));
+        }
+        let mut set = |slot: usize, value: (f64, f64)| -> Result<(), VerifyFileError> {
+            if let Some(other) = set_by[slot].replace(f) {
+                return Err(bad(
+                    f,
+                    format!("the unknown is given twice (by {other} and {f})"),
+                ));
             }
+            unknowns[slot] = Some(value);
+            Ok(())
         };
+        let vector =
+            |base: usize, set: &mut dyn FnMut(usize, (f64, f64)) -> Result<(), VerifyFileError>| {
+                match raw {
+                    Raw::List(v) if v.len() == 3 => {
+                        for (c, &(x, u)) in v.iter().enumerate() {
+                            usable(x, u)
+                                .map_err(|why| bad(f, format!("component {}: {why}", c + 1)))?;
+                            set(base + c, (x, u))?;
+                        }
+                        Ok(())
+                    }
+                    _ => Err(bad(f, "three finite numbers [x, y, z]".into())),
+                }
+            };
         match f {
             "name" => match raw {
                 Raw::Text(t) => name = t.clone(),
                 Raw::Number(x, _) => name = format!("{x}"),
                 _ => return Err(bad(f, "a name".into())),
             },
-            "n0" => vector(0, f)?,
-            "m0" if !strip => vector(3, f)?,
+            "n0" => vector(0, &mut set)?,
+            "m0" if !strip => vector(3, &mut set)?,
             "m0" => {
                 return Err(bad(
                     f,
@@ -402,11 +486,12 @@ fn solution(
                 ));
             }
             "n0_1" | "n0_2" | "n0_3" => {
-                unknowns[f.as_bytes()[3] as usize - b'1' as usize] = Some(finite(f, raw)?)
+                set(f.as_bytes()[3] as usize - b'1' as usize, finite(f, raw)?)?
             }
-            "m0_1" | "m0_2" | "m0_3" if !strip => {
-                unknowns[3 + f.as_bytes()[3] as usize - b'1' as usize] = Some(finite(f, raw)?)
-            }
+            "m0_1" | "m0_2" | "m0_3" if !strip => set(
+                3 + f.as_bytes()[3] as usize - b'1' as usize,
+                finite(f, raw)?,
+            )?,
             "u1_0" | "m2_0" | "u3_0" if !strip => {
                 return Err(bad(
                     f,
@@ -426,8 +511,11 @@ fn solution(
             },
             _ => {
                 if let Some(&(_, slot)) = slots.iter().find(|(n, _)| *n == f) {
-                    unknowns[slot] = Some(finite(f, raw)?);
+                    set(slot, finite(f, raw)?)?;
                 } else if let Some(p) = Parameter::named(f) {
+                    if let Some(why) = absent_from(p, law) {
+                        return Err(bad(f, why.into()));
+                    }
                     let (v, u) = finite(f, raw)?;
                     if parameters.iter().any(|(q, _)| *q == p) {
                         return Err(bad(f, format!("{} is given twice", p.name())));
@@ -466,6 +554,22 @@ fn solution(
         rounding,
         claims,
     })
+}
+
+/// Why the law has no parameter `p`, if it has none.
+fn absent_from(p: Parameter, law: Law) -> Option<&'static str> {
+    match (p, law) {
+        (Parameter::K2, Law::Strip { .. }) => {
+            Some("the strip law has no K2 (u2 = 0 is a constraint): the row sets no stiffness")
+        }
+        (Parameter::K2, Law::Unbendable) => {
+            Some("the unbendable rod has no K2 (u2 = 0 is a constraint): the row sets no stiffness")
+        }
+        (Parameter::K3, Law::Strip { .. }) => {
+            Some("the strip law has no K3 (bending and twisting do not separate)")
+        }
+        _ => None,
+    }
 }
 
 #[cfg(test)]

@@ -304,7 +304,8 @@ impl Scene {
         if self.clamps.start.is_some() {
             return Err(invalid(
                 "model.strip_width",
-                "the ribbon's walls are heights along e3, the paper's s = 0 clamp:                  use strip_width = 0 with [clamps.start]",
+                "the ribbon's walls are heights along e3, the paper's s = 0 clamp: \
+                 use strip_width = 0 with [clamps.start]",
             ));
         }
         Ok(())
@@ -364,7 +365,8 @@ impl Scene {
         {
             return Err(invalid(
                 "clamps.start",
-                "strip shooting starts from the paper's s = 0 clamp (identity at the origin);                  start a strip with a general s = 0 clamp from another shape",
+                "strip shooting starts from the paper's s = 0 clamp (identity at the origin); \
+                 start a strip with a general s = 0 clamp from another shape",
             ));
         }
         if general && self.initial.shape == InitialShape::DoubleRing {

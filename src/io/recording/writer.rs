@@ -8,6 +8,7 @@ use super::messages::{
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
 use crate::io::error::{IoError, Result};
+use crate::io::output::Output;
 use crate::model::rod::RodModel;
 use foxglove::Encode;
 use foxglove::messages::{
@@ -15,14 +16,18 @@ use foxglove::messages::{
 };
 use mcap::records::{MessageHeader, Metadata};
 use std::collections::BTreeMap;
-use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-/// An MCAP recording being written. Call [`Recorder::finish`]: dropping it
-/// unfinished leaves a file without its summary.
+/// An MCAP recording being written, to a temporary file that
+/// [`Recorder::finish`] finalises and renames into place (see [`Output`]):
+/// dropped unfinished, or after a failed write, it leaves the file that was
+/// there as it was.
 pub struct Recorder {
     writer: Option<Mcap>,
+    /// The first failure: later calls name it (the MCAP writer itself only
+    /// says that an earlier write failed), and `finish` returns it.
+    failed: Option<IoError>,
     path: PathBuf,
     channels: [u16; 5],
     count: u64,
@@ -40,14 +45,17 @@ fn encode<T: Encode>(m: &T, path: &Path) -> Result<Vec<u8>> {
     Ok(buf)
 }
 
-/// An MCAP writer error at `step` on `path`.
+/// An MCAP writer error at `step` on `path`: a full disk as such.
 fn mcap_error(step: &'static str, path: &Path) -> impl FnOnce(mcap::McapError) -> IoError {
     let path = path.to_path_buf();
-    move |source| IoError::Mcap { step, path, source }
+    move |source| match source {
+        mcap::McapError::Io(e) => crate::io::output::file_error(step, &path, e),
+        source => IoError::Mcap { step, path, source },
+    }
 }
 
 /// The MCAP writer of a recording file.
-type Mcap = mcap::Writer<BufWriter<File>>;
+type Mcap = mcap::Writer<BufWriter<Output>>;
 
 /// The five channels, in the order of [`Recorder`]'s `channels`.
 fn add_channels(writer: &mut Mcap, path: &Path) -> Result<[u16; 5]> {
@@ -117,8 +125,7 @@ impl Recorder {
         model: &RodModel,
         rod_diameter: f64,
     ) -> Result<Self> {
-        crate::io::json::create_parent(path)?;
-        let file = File::create(path).map_err(IoError::file("creating recording", path))?;
+        let file = Output::create(path)?;
         let mut writer = mcap::WriteOptions::new()
             .profile("")
             .library(format!("knotrod {}", env!("CARGO_PKG_VERSION")))
@@ -128,6 +135,7 @@ impl Recorder {
         write_metadata(&mut writer, path, scene_text, model)?;
         Ok(Recorder {
             writer: Some(writer),
+            failed: None,
             path: path.into(),
             channels,
             count: 0,
@@ -147,22 +155,55 @@ impl Recorder {
         &self.path
     }
 
-    fn write(&mut self, channel: usize, log_time: u64, data: &[u8]) -> Result<()> {
-        let w = self.writer.as_mut().ok_or_else(|| IoError::Recording {
+    /// The writer, unless finished or failed (then the first failure).
+    fn writer(&mut self) -> Result<&mut Mcap> {
+        if let Some(first) = &self.failed {
+            return Err(IoError::Recording {
+                path: self.path.clone(),
+                reason: format!("not written: {first}"),
+            });
+        }
+        self.writer.as_mut().ok_or_else(|| IoError::Recording {
             path: self.path.clone(),
             reason: "recording already finished".into(),
-        })?;
+        })
+    }
+
+    /// Keep the first failure of `r` (returned by `finish`); this call
+    /// answers with a copy.
+    fn note<T>(&mut self, r: Result<T>) -> Result<T> {
+        r.map_err(|e| {
+            let path = self.path.clone();
+            let copy = match &e {
+                IoError::NoSpace { .. } => IoError::NoSpace { path },
+                e => IoError::Recording {
+                    path,
+                    reason: std::error::Error::source(e)
+                        .map_or_else(|| e.to_string(), |s| format!("writing failed: {s}")),
+                },
+            };
+            self.failed.get_or_insert(e);
+            copy
+        })
+    }
+
+    fn write(&mut self, channel: usize, log_time: u64, data: &[u8]) -> Result<()> {
         self.sequence += 1;
-        w.write_to_known_channel(
-            &MessageHeader {
-                channel_id: self.channels[channel],
-                sequence: self.sequence,
-                log_time,
-                publish_time: log_time,
-            },
-            data,
-        )
-        .map_err(mcap_error("writing a message", &self.path))
+        let (sequence, channel_id, path) =
+            (self.sequence, self.channels[channel], self.path.clone());
+        let w = self.writer()?;
+        let r = w
+            .write_to_known_channel(
+                &MessageHeader {
+                    channel_id,
+                    sequence,
+                    log_time,
+                    publish_time: log_time,
+                },
+                data,
+            )
+            .map_err(mcap_error("writing a message", &path));
+        self.note(r)
     }
 
     /// Record one equilibrium (log time = its index, in seconds).
@@ -225,11 +266,21 @@ impl Recorder {
         self.count == 0
     }
 
-    /// Write the summary and close the file.
+    /// Write the summary, close the file and rename it into place. After a
+    /// failed write the temporary file is removed instead and the first
+    /// failure returned.
     pub fn finish(mut self) -> Result<()> {
-        if let Some(mut w) = self.writer.take() {
-            w.finish().map_err(mcap_error("finalising", &self.path))?;
+        if let Some(first) = self.failed.take() {
+            return Err(first);
         }
-        Ok(())
+        let Some(mut w) = self.writer.take() else {
+            return Ok(());
+        };
+        w.finish().map_err(mcap_error("finalising", &self.path))?;
+        let out = w
+            .into_inner()
+            .into_inner()
+            .map_err(|e| crate::io::output::file_error("finalising", &self.path, e.into_error()))?;
+        out.commit()
     }
 }
