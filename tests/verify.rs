@@ -349,7 +349,12 @@ stable = true
         );
         assert_eq!(c.negative(), Some(0), "{}: {s:?}", c.given.name);
         assert!(claim(c, "stable"), "{}: {:?}", c.given.name, c.claims);
-        assert_eq!(c.verdict, Verdict::Confirmed, "{}", verdict_line(c, &checks));
+        assert_eq!(
+            c.verdict,
+            Verdict::Confirmed,
+            "{}",
+            verdict_line(c, &checks)
+        );
     }
     // the summary's count is the extrapolated one
     let table = summary(&checks);
@@ -456,7 +461,13 @@ knot = "pretzel"
         [50, 100, 200],
     );
     for c in &checks[..2] {
-        assert_eq!(c.verdict, Verdict::NotASolution, "{}: {:?}", c.given.name, c.error);
+        assert_eq!(
+            c.verdict,
+            Verdict::NotASolution,
+            "{}: {:?}",
+            c.given.name,
+            c.error
+        );
         assert_eq!(c.error, None);
         assert!(c.der.is_empty() && c.negative().is_none() && c.claims.is_empty());
     }
@@ -465,13 +476,30 @@ knot = "pretzel"
     }
     match &checks[2].verdict {
         Verdict::Failed(why) => {
-            assert!(why.contains("knot") && why.contains("pretzel") && why.contains("trefoil"), "{why}")
+            assert!(
+                why.contains("knot") && why.contains("pretzel") && why.contains("trefoil"),
+                "{why}"
+            )
         }
         v => panic!("{v:?}"),
     }
     // the report states its setting and what the verdicts mean
-    let md = markdown("knotrod verify rows.toml", "rows.toml", &checks, [50, 100, 200], None);
-    for says in ["K2", "K3", "stretching stiffness", "1e7", "N, 2N, 4N", "METHODS DISAGREE", "undecided"] {
+    let md = markdown(
+        "knotrod verify rows.toml",
+        "rows.toml",
+        &checks,
+        [50, 100, 200],
+        None,
+    );
+    for says in [
+        "K2",
+        "K3",
+        "stretching stiffness",
+        "1e7",
+        "N, 2N, 4N",
+        "METHODS DISAGREE",
+        "undecided",
+    ] {
         assert!(md.contains(says), "{says}: {md}");
     }
 }
@@ -496,11 +524,18 @@ lowest_omega2 = -479.9
         panic!("{}", verdict_line(c, &checks));
     };
     assert!(
-        why.iter().any(|d| matches!(d, Disagreement::KnotChangesWithN(_))),
+        why.iter()
+            .any(|d| matches!(d, Disagreement::KnotChangesWithN(_))),
         "{why:?}"
     );
     assert!(
-        why.iter().any(|d| matches!(d, Disagreement::Order { quantity: Quantity::Force, .. })),
+        why.iter().any(|d| matches!(
+            d,
+            Disagreement::Order {
+                quantity: Quantity::Force,
+                ..
+            }
+        )),
         "{why:?}"
     );
     assert_eq!(outcome(c, "lowest ω²"), ClaimOutcome::Undecided);

@@ -114,10 +114,9 @@ fn inertia(c: &SolutionCheck) -> String {
     let Some(s) = &c.stability else {
         return "stability unknown".into();
     };
-    let lowest = s
-        .eigenvalues
-        .first()
-        .map_or(String::new(), |e| format!("lowest ω² {:.4} ± {:.1e}", e.extrapolated, e.bar()));
+    let lowest = s.eigenvalues.first().map_or(String::new(), |e| {
+        format!("lowest ω² {:.4} ± {:.1e}", e.extrapolated, e.bar())
+    });
     match (s.stable(), s.negative()) {
         (Some(true), _) => "stable".to_string(),
         (Some(false), Some(k)) => format!(
@@ -152,11 +151,13 @@ fn disagreement(d: &Disagreement) -> String {
         Disagreement::InertiaChangesWithN(n) => format!(
             "the discrete rod's negative count changes with N ({}) through an eigenvalue \
              that does not converge: not one equilibrium",
-            n.iter().map(|k| k.to_string()).collect::<Vec<_>>().join(" / ")
+            n.iter()
+                .map(|k| k.to_string())
+                .collect::<Vec<_>>()
+                .join(" / ")
         ),
         Disagreement::Order { quantity, order } => format!(
-            "{}: observed order {order:.2}, outside [{}, {}] (N is not in the asymptotic range; \
-             the error estimate means nothing)",
+            "{}: observed order {order:.2}, outside [{}, {}]",
             quantity.name(),
             ORDERS.start(),
             ORDERS.end()
@@ -183,11 +184,33 @@ pub fn verdict_line(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
             all.get(*of).map_or("?".into(), inertia),
             refuted(c)
         ),
-        Verdict::MethodsDisagree { why } => format!(
-            "METHODS DISAGREE: {}{}",
-            why.iter().map(disagreement).collect::<Vec<_>>().join("; "),
-            refuted(c)
-        ),
+        Verdict::MethodsDisagree { why } => {
+            // the orders in one clause
+            let orders: Vec<String> = why
+                .iter()
+                .filter_map(|d| match d {
+                    Disagreement::Order { quantity, order } => {
+                        Some(format!("{} {order:.2}", quantity.name()))
+                    }
+                    _ => None,
+                })
+                .collect();
+            let mut reasons: Vec<String> = why
+                .iter()
+                .filter(|d| !matches!(d, Disagreement::Order { .. }))
+                .map(disagreement)
+                .collect();
+            if !orders.is_empty() {
+                reasons.push(format!(
+                    "observed orders outside [{}, {}]: {} (N is not in the asymptotic range; \
+                     the error estimates mean nothing)",
+                    ORDERS.start(),
+                    ORDERS.end(),
+                    orders.join(", ")
+                ));
+            }
+            format!("METHODS DISAGREE: {}{}", reasons.join("; "), refuted(c))
+        }
         Verdict::ClaimsRefuted => format!("CLAIMS REFUTED{}{twin}", refuted(c)),
         Verdict::Confirmed => format!(
             "CONFIRMED by both methods ({}, knot {}{}){}{twin}{}",
@@ -437,7 +460,12 @@ pub fn header(checks: &[SolutionCheck]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "| setting | value |\n|---|---|");
     let _ = writeln!(s, "| law | {} |", c.law);
-    let _ = writeln!(s, "| clamps (row {}) | {} |", c.index + 1, clamp_parameters(st));
+    let _ = writeln!(
+        s,
+        "| clamps (row {}) | {} |",
+        c.index + 1,
+        clamp_parameters(st)
+    );
     let _ = writeln!(s, "| K2 = B22/B11, K3 = B33/B11 | {}, {} |", st.k2, st.k3);
     if let Some(e) = st.strip_epsilon {
         let _ = writeln!(s, "| strip regularisation ε | {e:e} |");
