@@ -452,6 +452,11 @@ n0 = [5.484462436, -9.851921754, 8.374621939]
 m0 = [-31.956304646, 30.008967518, 36.268060172]
 
 [[solution]]
+name = "Appendix D, m0 negated"
+n0 = [-24.743, 17.772, 37.145]
+m0 = [-7.5317, 8.7100, -4.529]
+
+[[solution]]
 name = "unknown knot name"
 phi_over_2pi = 0.76
 n0 = [-31.956304646, 30.008967518, 36.268060172]
@@ -460,7 +465,7 @@ knot = "pretzel"
 "#,
         [50, 100, 200],
     );
-    for c in &checks[..2] {
+    for c in &checks[..3] {
         assert_eq!(
             c.verdict,
             Verdict::NotASolution,
@@ -471,10 +476,13 @@ knot = "pretzel"
         assert_eq!(c.error, None);
         assert!(c.der.is_empty() && c.negative().is_none() && c.claims.is_empty());
     }
-    for row in summary(&checks).lines().skip(1).take(2) {
+    // the Appendix D knot's m0 negated: no Newton polish converges
+    assert_eq!(checks[2].input, InputVerdict::NoSolutionNearby);
+    assert!(checks[2].input_error.as_deref().unwrap().contains("Newton"));
+    for row in summary(&checks).lines().skip(1).take(3) {
         assert!(row.contains("—  NOT A SOLUTION"), "{row}");
     }
-    match &checks[2].verdict {
+    match &checks[3].verdict {
         Verdict::Failed(why) => {
             assert!(
                 why.contains("knot") && why.contains("pretzel") && why.contains("trefoil"),
