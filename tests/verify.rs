@@ -4,8 +4,10 @@
 
 use knotrod::io::verify_file::{VerifyFileError, read_solutions};
 use knotrod::model::rod::Parameter;
+use knotrod::report::verify::{markdown, summary, verdict_line};
 use knotrod::study::verify::{
-    InputVerdict, Quantity, SolutionCheck, Verdict, VerifyOptions, verify_all,
+    ClaimOutcome, Disagreement, InputVerdict, Quantity, SolutionCheck, Verdict, VerifyOptions,
+    verify_all,
 };
 use std::path::Path;
 
@@ -29,7 +31,7 @@ fn claim(c: &SolutionCheck, name: &str) -> bool {
         .iter()
         .find(|k| k.claim == name)
         .unwrap_or_else(|| panic!("no claim {name}"))
-        .confirmed
+        .confirmed()
 }
 
 #[test]
@@ -95,7 +97,13 @@ fn a_second_equilibrium_at_the_same_clamps_is_told_apart_with_its_inertia() {
         assert!(relative(c, Quantity::Force) < 1e-4);
     }
     assert_eq!(a.verdict, Verdict::Confirmed);
-    assert_eq!(b.verdict, Verdict::DifferentEquilibrium { of: 0 });
+    assert_eq!(
+        b.verdict,
+        Verdict::DifferentEquilibrium {
+            of: 0,
+            claims_refuted: true
+        }
+    );
     assert_eq!(a.negative(), Some(0));
     assert_eq!(b.negative(), Some(1));
     // its author's claim of stability is refuted
@@ -462,4 +470,266 @@ fn a_verify_run_past_the_budget_is_refused_up_front_naming_the_option() {
     assert!(out.status.success(), "{err}");
     assert!(err.contains("--threads 100000: capped at"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Rows of solutions (TOML, after the scene line) on the Appendix D scene,
+/// verified at `segments`.
+fn verify_rows(name: &str, rows: &str, segments: [usize; 3]) -> Vec<SolutionCheck> {
+    let dir = common::temp_dir(name);
+    let scene = std::fs::canonicalize("scenes/appendix_d.toml").unwrap();
+    let path = dir.join("rows.toml");
+    let head = format!("scene = {:?}\n", scene.display().to_string());
+    std::fs::write(&path, head + rows).unwrap();
+    let (scene, solutions) = read_solutions(&path, None).unwrap();
+    let options = VerifyOptions {
+        segments,
+        ..VerifyOptions::default()
+    };
+    let checks = verify_all(&scene, &solutions, &options, &|_| Ok(())).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    checks
+}
+
+fn outcome(c: &SolutionCheck, name: &str) -> ClaimOutcome {
+    c.claims
+        .iter()
+        .find(|k| k.claim == name)
+        .unwrap_or_else(|| panic!("no claim {name}"))
+        .outcome
+}
+
+#[test]
+fn stability_just_above_s_comes_from_the_extrapolated_eigenvalue() {
+    // the Figure 3 branch just above its pitchfork S (continuum λ1 = +3.92
+    // and +0.142): the discrete rod at N = 100 (and at 0.751 at every N)
+    // still has a negative direction
+    let checks = verify_rows(
+        "verify-above-s",
+        r#"
+[[solution]]
+name = "0.752"
+phi_over_2pi = 0.752
+n0 = [-34.097637303885, 33.671823618830, 35.205013397374]
+m0 = [4.810233596407, -9.859666283300, 9.618680265148]
+stable = true
+
+[[solution]]
+name = "0.751"
+phi_over_2pi = 0.751
+n0 = [-34.413645171006, 34.198094395970, 35.014585973752]
+m0 = [4.710946951049, -9.848379939559, 9.800209857933]
+stable = true
+"#,
+        [100, 200, 400],
+    );
+    for (c, lambda) in checks.iter().zip([3.92, 0.142]) {
+        assert_eq!(c.der[0].negative, 1, "{}: {:?}", c.given.name, c.der);
+        let s = c.stability.as_ref().unwrap();
+        let low = &s.eigenvalues[0];
+        assert!(
+            (low.extrapolated - lambda).abs() < 0.02,
+            "{}: {low:?}",
+            c.given.name
+        );
+        assert_eq!(c.negative(), Some(0), "{}: {s:?}", c.given.name);
+        assert!(claim(c, "stable"), "{}: {:?}", c.given.name, c.claims);
+        assert_eq!(
+            c.verdict,
+            Verdict::Confirmed,
+            "{}",
+            verdict_line(c, &checks)
+        );
+    }
+    // the summary's count is the extrapolated one
+    let table = summary(&checks);
+    let row = table.lines().find(|l| l.contains("0.751")).unwrap();
+    assert!(row.contains(" 0  CONFIRMED"), "{row}");
+}
+
+/// The two equilibria of two_equilibria.toml at φ/2π = 0.76, given with
+/// and without the scene's z* and δ, repeated and rounded.
+const TWINS: &str = r#"
+[[solution]]
+name = "knot"
+phi_over_2pi = 0.76
+n0 = [-31.956304646, 30.008967518, 36.268060172]
+m0 = [5.484462436, -9.851921754, 8.374621939]
+stable = true
+knot = "trefoil"
+
+[[solution]]
+name = "saddle"
+z_star = 0.115
+delta = 0.05
+phi_over_2pi = 0.76
+n0 = [-15.193167635, 64.953033666, 0.958779246]
+m0 = [7.606847029, -0.325753296, 16.410793040]
+stable = false
+
+[[solution]]
+name = "knot, 4 digits"
+z_star = 0.115
+phi_over_2pi = 0.76
+n0 = [-31.9563, 30.0090, 36.2681]
+m0 = [5.4845, -9.8519, 8.3746]
+stable = true
+
+[[solution]]
+name = "saddle claimed stable"
+phi_over_2pi = 0.76
+n0 = [-15.193167635, 64.953033666, 0.958779246]
+m0 = [7.606847029, -0.325753296, 16.410793040]
+stable = true
+"#;
+
+#[test]
+fn rows_are_grouped_by_the_equilibrium_they_polish_to_in_the_resolved_scene() {
+    let checks = verify_rows("verify-twins", TWINS, [50, 100, 200]);
+    let line = |k: usize| verdict_line(&checks[k], &checks);
+    assert_eq!(checks[0].verdict, Verdict::Confirmed, "{}", line(0));
+    // "trefoil" is the table's 3_1
+    assert_eq!(outcome(&checks[0], "knot"), ClaimOutcome::Confirmed);
+    // the saddle gives z* and δ, the knot takes them from the scene: the
+    // same parameters all the same
+    assert_eq!(
+        checks[1].verdict,
+        Verdict::DifferentEquilibrium {
+            of: 0,
+            claims_refuted: false
+        },
+        "{}",
+        line(1)
+    );
+    assert_eq!(checks[1].negative(), Some(1));
+    // the knot again, rounded, after the saddle: row 1's twin
+    assert_eq!(checks[2].input, InputVerdict::Rounded);
+    assert_eq!(checks[2].same_as, Some(0));
+    assert_eq!(checks[2].verdict, Verdict::Confirmed, "{}", line(2));
+    // the saddle again with a false claim: different, and the claim shows
+    assert_eq!(checks[3].same_as, Some(1));
+    assert_eq!(
+        checks[3].verdict,
+        Verdict::DifferentEquilibrium {
+            of: 0,
+            claims_refuted: true
+        }
+    );
+    assert!(line(3).contains("claims refuted: stable"), "{}", line(3));
+}
+
+#[test]
+fn grossly_wrong_unknowns_are_not_a_solution_and_show_no_inertia() {
+    let checks = verify_rows(
+        "verify-gross",
+        r#"
+[[solution]]
+name = "m0 negated"
+phi_over_2pi = 0.76
+n0 = [-31.956304646, 30.008967518, 36.268060172]
+m0 = [-5.484462436, 9.851921754, -8.374621939]
+stable = true
+
+[[solution]]
+name = "n0 and m0 swapped"
+phi_over_2pi = 0.76
+n0 = [5.484462436, -9.851921754, 8.374621939]
+m0 = [-31.956304646, 30.008967518, 36.268060172]
+
+[[solution]]
+name = "Appendix D, m0 negated"
+n0 = [-24.743, 17.772, 37.145]
+m0 = [-7.5317, 8.7100, -4.529]
+
+[[solution]]
+name = "unknown knot name"
+phi_over_2pi = 0.76
+n0 = [-31.956304646, 30.008967518, 36.268060172]
+m0 = [5.484462436, -9.851921754, 8.374621939]
+knot = "pretzel"
+"#,
+        [50, 100, 200],
+    );
+    for c in &checks[..3] {
+        assert_eq!(
+            c.verdict,
+            Verdict::NotASolution,
+            "{}: {:?}",
+            c.given.name,
+            c.error
+        );
+        assert_eq!(c.error, None);
+        assert!(c.der.is_empty() && c.negative().is_none() && c.claims.is_empty());
+    }
+    // the Appendix D knot's m0 negated: no Newton polish converges
+    assert_eq!(checks[2].input, InputVerdict::NoSolutionNearby);
+    assert!(checks[2].input_error.as_deref().unwrap().contains("Newton"));
+    for row in summary(&checks).lines().skip(1).take(3) {
+        assert!(row.contains("—  NOT A SOLUTION"), "{row}");
+    }
+    match &checks[3].verdict {
+        Verdict::Failed(why) => {
+            assert!(
+                why.contains("knot") && why.contains("pretzel") && why.contains("trefoil"),
+                "{why}"
+            )
+        }
+        v => panic!("{v:?}"),
+    }
+    // the report states its setting and what the verdicts mean
+    let md = markdown(
+        "knotrod verify rows.toml",
+        "rows.toml",
+        &checks,
+        [50, 100, 200],
+        None,
+    );
+    for says in [
+        "K2",
+        "K3",
+        "stretching stiffness",
+        "1e7",
+        "N, 2N, 4N",
+        "METHODS DISAGREE",
+        "undecided",
+    ] {
+        assert!(md.contains(says), "{says}: {md}");
+    }
+}
+
+#[test]
+fn resolutions_that_are_not_one_equilibrium_make_the_methods_disagree() {
+    // at N = 10, 20 the rod is unknotted, at 40 the trefoil
+    let checks = verify_rows(
+        "verify-coarse",
+        r#"
+[[solution]]
+name = "knot"
+phi_over_2pi = 0.76
+n0 = [-31.956304646, 30.008967518, 36.268060172]
+m0 = [5.484462436, -9.851921754, 8.374621939]
+lowest_omega2 = -479.9
+"#,
+        [10, 20, 40],
+    );
+    let c = &checks[0];
+    let Verdict::MethodsDisagree { why } = &c.verdict else {
+        panic!("{}", verdict_line(c, &checks));
+    };
+    assert!(
+        why.iter()
+            .any(|d| matches!(d, Disagreement::KnotChangesWithN(_))),
+        "{why:?}"
+    );
+    assert!(
+        why.iter().any(|d| matches!(
+            d,
+            Disagreement::Order {
+                quantity: Quantity::Force,
+                ..
+            }
+        )),
+        "{why:?}"
+    );
+    assert_eq!(outcome(c, "lowest ω²"), ClaimOutcome::Undecided);
+    assert!(verdict_line(c, &checks).contains("knot type changes with N"));
 }

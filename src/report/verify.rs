@@ -3,7 +3,10 @@
 //! with its extrapolation against the continuum, the claims), as terminal
 //! text or markdown.
 
-use crate::study::verify::{InputVerdict, Quantity, SolutionCheck, Verdict};
+use crate::study::verify::{
+    BAR, ClaimOutcome, Disagreement, InputVerdict, ORDERS, Quantity, Setting, SolutionCheck,
+    Stability, Verdict,
+};
 use std::fmt::Write;
 
 fn vector(v: &[f64]) -> String {
@@ -66,69 +69,151 @@ pub fn input_line(c: &SolutionCheck) -> String {
         }
         InputVerdict::NoSolutionNearby => format!(
             "does not satisfy its boundary conditions, and no solution lies near it (s = 1 \
-             residual {})",
-            residual.map_or("—".into(), |r| format!("{r:.1e}"))
+             residual {}{})",
+            residual.map_or("—".into(), |r| format!("{r:.1e}")),
+            c.input_error
+                .as_deref()
+                .map_or(String::new(), |e| format!("; {e}"))
         ),
     }
 }
 
-/// "; claims refuted: …" naming each refuted claim (empty if none is).
+/// "; claims refuted: …; undecided: …" naming each claim not confirmed
+/// (empty if every one is).
 fn refuted(c: &SolutionCheck) -> String {
-    let which: Vec<String> = c
-        .claims
-        .iter()
-        .filter(|k| !k.confirmed)
-        .map(|k| format!("{} (claimed {}, found {})", k.claim, k.claimed, k.found))
-        .collect();
-    if which.is_empty() {
-        String::new()
-    } else {
-        format!("; claims refuted: {}", which.join("; "))
+    let mut s = String::new();
+    for (outcome, words) in [
+        (ClaimOutcome::Refuted, "claims refuted"),
+        (ClaimOutcome::Undecided, "claims undecided"),
+    ] {
+        let which: Vec<String> = c
+            .claims
+            .iter()
+            .filter(|k| k.outcome == outcome)
+            .map(|k| format!("{} (claimed {}, found {})", k.claim, k.claimed, k.found))
+            .collect();
+        if !which.is_empty() {
+            let _ = write!(s, "; {words}: {}", which.join("; "));
+        }
+    }
+    s
+}
+
+/// The count of negative directions, as far as the bars decide it: "2",
+/// "1 to 2" (one bar straddles 0), "at least 4" (none computed is positive).
+fn negative_count(s: &Stability) -> String {
+    match (s.undecided, s.complete) {
+        (0, true) => s.negative.to_string(),
+        (u, true) => format!("{} to {}", s.negative, s.negative + u),
+        (_, false) => format!("at least {}", s.negative),
+    }
+}
+
+/// Stable, unstable with its negative count, or undecided.
+fn inertia(c: &SolutionCheck) -> String {
+    let Some(s) = &c.stability else {
+        return "stability unknown".into();
+    };
+    let lowest = s.eigenvalues.first().map_or(String::new(), |e| {
+        format!("lowest ω² {:.4} ± {:.1e}", e.extrapolated, e.bar())
+    });
+    match (s.stable(), s.negative()) {
+        (Some(true), _) => "stable".to_string(),
+        (Some(false), Some(k)) => format!(
+            "unstable, {k} negative direction{}",
+            if k == 1 { "" } else { "s" }
+        ),
+        (Some(false), None) => format!("unstable, {} negative directions", negative_count(s)),
+        (None, _) => format!("stability undecided: {lowest} straddles 0"),
+    }
+}
+
+/// A reason the methods disagree, in words.
+fn disagreement(d: &Disagreement) -> String {
+    let knot = |k: &Option<String>| k.clone().unwrap_or_else(|| "none".into());
+    match d {
+        Disagreement::Differs(q) => format!(
+            "{} (the continuum's value lies outside the extrapolation's bar)",
+            q.name()
+        ),
+        Disagreement::Knot {
+            continuum,
+            discrete,
+        } => format!(
+            "the knot type (continuum {}, discrete rod {})",
+            knot(continuum),
+            knot(discrete)
+        ),
+        Disagreement::KnotChangesWithN(k) => format!(
+            "the discrete rod's knot type changes with N ({}): not one equilibrium",
+            k.iter().map(knot).collect::<Vec<_>>().join(" / ")
+        ),
+        Disagreement::InertiaChangesWithN(n) => format!(
+            "the discrete rod's negative count changes with N ({}) through an eigenvalue \
+             that does not converge: not one equilibrium",
+            n.iter()
+                .map(|k| k.to_string())
+                .collect::<Vec<_>>()
+                .join(" / ")
+        ),
+        Disagreement::Order { quantity, order } => format!(
+            "{}: observed order {order:.2}, outside [{}, {}]",
+            quantity.name(),
+            ORDERS.start(),
+            ORDERS.end()
+        ),
     }
 }
 
 /// The one-line verdict.
 pub fn verdict_line(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
-    let inertia = |c: &SolutionCheck| match c.negative() {
-        Some(0) => "stable".to_string(),
-        Some(k) => format!(
-            "unstable, {k} negative direction{}",
-            if k == 1 { "" } else { "s" }
-        ),
-        None => "stability unknown".into(),
-    };
+    let name = |k: usize| all.get(k).map_or("?", |o| o.given.name.as_str());
+    let twin = c.same_as.map_or(String::new(), |k| {
+        format!("; the same equilibrium as row {} ({})", k + 1, name(k))
+    });
     match &c.verdict {
         Verdict::Failed(why) => format!("FAILED: {why}"),
         Verdict::NotASolution => format!("NOT A SOLUTION: {}", input_line(c)),
-        Verdict::DifferentEquilibrium { of } => format!(
-            "A DIFFERENT EQUILIBRIUM from {} at the same parameters ({}; {} is {}); both methods \
-             agree on it{}",
-            all.get(*of).map_or("?", |o| o.given.name.as_str()),
+        Verdict::DifferentEquilibrium { of, .. } => format!(
+            "A DIFFERENT EQUILIBRIUM from row {} ({}) at the same parameters ({}; {} is {}); \
+             both methods agree on it{twin}{}",
+            of + 1,
+            name(*of),
             inertia(c),
-            all.get(*of).map_or("?", |o| o.given.name.as_str()),
+            name(*of),
             all.get(*of).map_or("?".into(), inertia),
             refuted(c)
         ),
-        Verdict::MethodsDisagree => {
-            let which: Vec<&str> = c
-                .estimates
+        Verdict::MethodsDisagree { why } => {
+            // the orders in one clause
+            let orders: Vec<String> = why
                 .iter()
-                .filter(|e| e.agrees == Some(false))
-                .map(|e| e.quantity.name())
+                .filter_map(|d| match d {
+                    Disagreement::Order { quantity, order } => {
+                        Some(format!("{} {order:.2}", quantity.name()))
+                    }
+                    _ => None,
+                })
                 .collect();
-            format!(
-                "METHODS DISAGREE on {} (the discrete rod does not converge to the continuum \
-                 solution within its error estimate)",
-                if which.is_empty() {
-                    "the knot type".to_string()
-                } else {
-                    which.join(", ")
-                }
-            )
+            let mut reasons: Vec<String> = why
+                .iter()
+                .filter(|d| !matches!(d, Disagreement::Order { .. }))
+                .map(disagreement)
+                .collect();
+            if !orders.is_empty() {
+                reasons.push(format!(
+                    "observed orders outside [{}, {}]: {} (N is not in the asymptotic range; \
+                     the error estimates mean nothing)",
+                    ORDERS.start(),
+                    ORDERS.end(),
+                    orders.join(", ")
+                ));
+            }
+            format!("METHODS DISAGREE: {}{}", reasons.join("; "), refuted(c))
         }
-        Verdict::ClaimsRefuted => format!("CLAIMS REFUTED{}", refuted(c)),
+        Verdict::ClaimsRefuted => format!("CLAIMS REFUTED{}{twin}", refuted(c)),
         Verdict::Confirmed => format!(
-            "CONFIRMED by both methods ({}, knot {}{}){}",
+            "CONFIRMED by both methods ({}, knot {}{}){}{twin}{}",
             inertia(c),
             c.continuum_knot.as_deref().unwrap_or("none"),
             if c.claims.is_empty() {
@@ -145,7 +230,8 @@ pub fn verdict_line(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
                 ),
                 (InputVerdict::Rounded, _) => "; the unknowns are rounded".into(),
                 _ => String::new(),
-            }
+            },
+            refuted(c)
         ),
     }
 }
@@ -176,7 +262,7 @@ pub fn summary(checks: &[SolutionCheck]) -> String {
             c.rounding_units.map_or("—".into(), |u| format!("{u:.1}")),
             rel(Quantity::Force),
             rel(Quantity::Moment),
-            c.negative().map_or("—".into(), |k| k.to_string()),
+            c.stability.as_ref().map_or("—".into(), negative_count),
             verdict_line(c, checks)
         );
     }
@@ -187,14 +273,8 @@ pub fn summary(checks: &[SolutionCheck]) -> String {
 pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "### {}. {} ({})\n", c.index + 1, c.given.name, c.law);
-    if !c.given.parameters.is_empty() {
-        let p: Vec<String> = c
-            .given
-            .parameters
-            .iter()
-            .map(|(p, v)| format!("{} = {v}", p.name()))
-            .collect();
-        let _ = writeln!(s, "Parameters: {}.\n", p.join(", "));
+    if let Some(setting) = &c.setting {
+        let _ = writeln!(s, "Parameters: {}.\n", clamp_parameters(setting));
     }
     let _ = writeln!(s, "**Verdict:** {}\n", verdict_line(c, all));
     let _ = writeln!(s, "**Input:** {}\n", input_line(c));
@@ -271,6 +351,34 @@ pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
         }
         let _ = writeln!(s);
     }
+    if let Some(st) = c.stability.as_ref().filter(|st| !st.eigenvalues.is_empty()) {
+        let _ = writeln!(
+            s,
+            "| ω²_k | at N, 2N, 4N | Richardson | discretisation error | stiffness error | order | sign (bar {BAR}× the errors) |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+        for (k, e) in st.eigenvalues.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "| {} | {:.4} / {:.4} / {:.4} | {:.6} | {:.1e} | {:.1e} | {:.2} | {:?} |",
+                k + 1,
+                e.values[0],
+                e.values[1],
+                e.values[2],
+                e.extrapolated,
+                e.error,
+                e.model_error,
+                e.order,
+                e.sign()
+            );
+        }
+        let _ = writeln!(
+            s,
+            "\nNegative directions of the extrapolated equilibrium: {} ({}).\n",
+            negative_count(st),
+            inertia(c)
+        );
+    }
     if !c.estimates.is_empty() {
         let _ = writeln!(
             s,
@@ -301,7 +409,7 @@ pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
         );
     }
     if !c.claims.is_empty() {
-        let _ = writeln!(s, "| claim | claimed | found | confirmed |");
+        let _ = writeln!(s, "| claim | claimed | found | outcome |");
         let _ = writeln!(s, "|---|---|---|---|");
         for k in &c.claims {
             let _ = writeln!(
@@ -310,7 +418,11 @@ pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
                 k.claim,
                 k.claimed,
                 k.found,
-                if k.confirmed { "yes" } else { "NO" }
+                match k.outcome {
+                    ClaimOutcome::Confirmed => "confirmed",
+                    ClaimOutcome::Refuted => "REFUTED",
+                    ClaimOutcome::Undecided => "undecided",
+                }
             );
         }
         let _ = writeln!(s);
@@ -319,6 +431,93 @@ pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
         let _ = writeln!(s, "Error: {e}\n");
     }
     s
+}
+
+/// z*, δ, φ/2π and every other clamp parameter that is not zero.
+fn clamp_parameters(setting: &Setting) -> String {
+    use crate::model::rod::Parameter;
+    let shown: Vec<String> = setting
+        .clamps
+        .iter()
+        .filter(|(p, v)| {
+            matches!(p, Parameter::ZStar | Parameter::Delta | Parameter::Phi) || *v != 0.0
+        })
+        .map(|(p, v)| format!("{} = {v}", p.name()))
+        .collect();
+    shown.join(", ")
+}
+
+/// The setting of the first row that has one (rows may differ in their
+/// clamps, each row's are in its details): law, K2, K3, the strip's ε, the
+/// weight, S, N and the integrator's tolerance.
+pub fn header(checks: &[SolutionCheck]) -> String {
+    let Some((c, st)) = checks
+        .iter()
+        .find_map(|c| c.setting.as_ref().map(|s| (c, s)))
+    else {
+        return String::new();
+    };
+    let mut s = String::new();
+    let _ = writeln!(s, "| setting | value |\n|---|---|");
+    let _ = writeln!(s, "| law | {} |", c.law);
+    let _ = writeln!(
+        s,
+        "| clamps (row {}) | {} |",
+        c.index + 1,
+        clamp_parameters(st)
+    );
+    let _ = writeln!(s, "| K2 = B22/B11, K3 = B33/B11 | {}, {} |", st.k2, st.k3);
+    if let Some(e) = st.strip_epsilon {
+        let _ = writeln!(s, "| strip regularisation ε | {e:e} |");
+    }
+    let _ = writeln!(
+        s,
+        "| weight w L³/B11 | ({}, {}, {}) |",
+        st.weight[0], st.weight[1], st.weight[2]
+    );
+    let _ = writeln!(
+        s,
+        "| stretching stiffness S (the model error from S/10) | {:e} |",
+        st.stiffness
+    );
+    let _ = writeln!(
+        s,
+        "| N, 2N, 4N | {}, {}, {} |",
+        st.segments[0], st.segments[1], st.segments[2]
+    );
+    let _ = writeln!(s, "| integrator tolerance | {:e} |", st.tolerance);
+    let _ = writeln!(
+        s,
+        "| rounding of an input | half a unit in its last printed digit |"
+    );
+    s
+}
+
+/// What each verdict means, and the rules behind them.
+pub fn legend() -> String {
+    format!(
+        "- **CONFIRMED**: a solution (or one rounded within its printed digits); the discrete \
+         rod converges to it (one equilibrium at N, 2N, 4N, observed orders in [{lo}, {hi}]), \
+         every quantity agrees within its bar, and every claim holds.\n\
+         - **CLAIMS REFUTED**: as confirmed, but a claim is not what was found, beyond its bar.\n\
+         - **A DIFFERENT EQUILIBRIUM**: a solution at the same parameters (the resolved scene) \
+         as an earlier row, polishing to another equilibrium than that row's; rows polishing to \
+         the same one are grouped and judged alike.\n\
+         - **METHODS DISAGREE**: the continuum lies outside the extrapolation's bar, the knot \
+         types differ, or the discrete rod is not one converging equilibrium (its knot type or \
+         inertia changes with N, or an observed order of a quantity resolved above the solves' \
+         accuracy lies outside [{lo}, {hi}]); the reason is named.\n\
+         - **NOT A SOLUTION**: the given unknowns miss their boundary conditions by more than \
+         their rounding explains, or no solution lies near them.\n\
+         - **FAILED**: the check itself could not be made (the reason is named).\n\n\
+         Bars are {BAR} times the summed errors (discretisation, stretching stiffness and the \
+         continuum's own). Stability and the count of negative directions come from the \
+         extrapolated eigenvalues ω²_k: negative or positive when the bar excludes 0, \
+         undecided when it straddles 0. A printed claim holds within one unit of its last \
+         digit plus the bar.\n",
+        lo = ORDERS.start(),
+        hi = ORDERS.end()
+    )
 }
 
 /// The markdown report: how it was made, the summary, each solution, and the
@@ -344,6 +543,8 @@ pub fn markdown(
          printed claim is confirmed within one unit of its last digit plus those errors.\n",
         segments[0], segments[1], segments[2]
     );
+    let _ = writeln!(s, "## Setting\n\n{}", header(checks));
+    let _ = writeln!(s, "## Verdicts\n\n{}", legend());
     let _ = writeln!(s, "## Summary\n\n```\n{}```\n", summary(checks));
     if let Some(p) = plot {
         let _ = writeln!(

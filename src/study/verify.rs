@@ -145,6 +145,8 @@ pub struct DerRow {
     pub link: f64,
     /// Lowest ω².
     pub lowest_omega2: Option<f64>,
+    /// The lowest ω² computed, ascending.
+    pub omega_squared: Vec<f64>,
     /// Negative directions of the second variation.
     pub negative: usize,
     /// Walled.
@@ -216,6 +218,18 @@ pub struct Estimate {
     pub agrees: Option<bool>,
 }
 
+/// How a claim fared.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+pub enum ClaimOutcome {
+    /// What was found, within its error bar.
+    Confirmed,
+    /// Not what was found, beyond its error bar.
+    Refuted,
+    /// The error bar does not decide it (it straddles the claim's boundary,
+    /// or the discrete rod did not converge).
+    Undecided,
+}
+
 /// A claim against what was found.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ClaimCheck {
@@ -225,8 +239,160 @@ pub struct ClaimCheck {
     pub claimed: String,
     /// Found.
     pub found: String,
+    /// Confirmed, refuted or undecided.
+    pub outcome: ClaimOutcome,
+}
+
+impl ClaimCheck {
     /// Confirmed.
-    pub confirmed: bool,
+    pub fn confirmed(&self) -> bool {
+        self.outcome == ClaimOutcome::Confirmed
+    }
+
+    /// Refuted.
+    pub fn refuted(&self) -> bool {
+        self.outcome == ClaimOutcome::Refuted
+    }
+}
+
+/// Error bars are this many times the summed error estimates wide (for
+/// agreement, signs of eigenvalues and claims alike).
+pub const BAR: f64 = 3.0;
+
+/// Observed orders accepted as the second-order method's asymptotic range:
+/// below 1 the resolutions do not converge; above 2 the error estimate is
+/// conservative, and up to 4 is common for eigenvalues at the default N
+/// (Appendix E's lowest ω² converges at 3.5 from N = 100).
+pub const ORDERS: std::ops::RangeInclusive<f64> = 1.0..=4.0;
+
+/// One eigenvalue ω²_k of the second variation at N, 2N, 4N, extrapolated.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Omega2 {
+    /// At N, 2N, 4N.
+    pub values: [f64; 3],
+    /// Richardson value (2N, 4N).
+    pub extrapolated: f64,
+    /// Discretisation error |R(N, 2N) − R(2N, 4N)|.
+    pub error: f64,
+    /// Stretching stiffness error |ω²(S) − ω²(S/10)| / 9 at N.
+    pub model_error: f64,
+    /// Observed order.
+    pub order: f64,
+}
+
+/// The sign of an extrapolated eigenvalue, given its bar.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+pub enum Sign {
+    /// Above zero by more than its bar.
+    Positive,
+    /// Below zero by more than its bar.
+    Negative,
+    /// Its bar straddles zero.
+    Undecided,
+}
+
+impl Omega2 {
+    /// Half-width of its bar: [`BAR`] times the summed errors.
+    pub fn bar(&self) -> f64 {
+        BAR * (self.error + self.model_error)
+    }
+
+    /// Its sign, given its bar.
+    pub fn sign(&self) -> Sign {
+        if self.extrapolated - self.bar() > 0.0 {
+            Sign::Positive
+        } else if self.extrapolated + self.bar() < 0.0 {
+            Sign::Negative
+        } else {
+            Sign::Undecided
+        }
+    }
+}
+
+/// Stability of the extrapolated equilibrium: from the Richardson values of
+/// its lowest eigenvalues and their bars (not from the discrete rod's
+/// inertia at any one N, which near a change of stability is on the wrong
+/// side of it at coarse N).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Stability {
+    /// The lowest eigenvalues, ascending at 4N.
+    pub eigenvalues: Vec<Omega2>,
+    /// Eigenvalues below zero by more than their bar.
+    pub negative: usize,
+    /// Eigenvalues whose bar straddles zero.
+    pub undecided: usize,
+    /// An eigenvalue above zero by more than its bar was computed: the
+    /// count is complete.
+    pub complete: bool,
+}
+
+impl Stability {
+    /// Stable (Some(true)), unstable (Some(false)) or undecided (None).
+    pub fn stable(&self) -> Option<bool> {
+        if self.negative > 0 {
+            Some(false)
+        } else if self.undecided > 0 || !self.complete {
+            None
+        } else {
+            Some(true)
+        }
+    }
+
+    /// The negative count, when it is decided.
+    pub fn negative(&self) -> Option<usize> {
+        (self.undecided == 0 && self.complete).then_some(self.negative)
+    }
+}
+
+/// Why the discrete rod and the continuum do not confirm each other.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub enum Disagreement {
+    /// The continuum's value lies outside the extrapolation's bar.
+    Differs(Quantity),
+    /// The continuum curve's knot type is not the discrete rod's.
+    Knot {
+        /// The continuum curve's.
+        continuum: Option<String>,
+        /// The discrete rod's at 4N.
+        discrete: Option<String>,
+    },
+    /// The discrete rod's knot type changes with N: the three resolutions
+    /// are not one equilibrium.
+    KnotChangesWithN(Vec<Option<String>>),
+    /// The negative count changes with N and an eigenvalue that crosses zero
+    /// does not converge (observed order outside [`ORDERS`], or not
+    /// computed): the three resolutions are not one equilibrium.
+    InertiaChangesWithN(Vec<usize>),
+    /// A quantity's observed order lies outside [`ORDERS`]: N, 2N, 4N are not
+    /// in the method's asymptotic range and the extrapolation's error
+    /// estimate means nothing.
+    Order {
+        /// Which.
+        quantity: Quantity,
+        /// Its observed order.
+        order: f64,
+    },
+}
+
+/// The setting a solution was verified in (the report's header).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Setting {
+    /// z*, δ, φ/2π and every other clamp parameter of the resolved scene.
+    pub clamps: Vec<(Parameter, f64)>,
+    /// K2 = B22/B11.
+    pub k2: f64,
+    /// K3 = B33/B11.
+    pub k3: f64,
+    /// The strip law's regularisation ε (None for a rod).
+    pub strip_epsilon: Option<f64>,
+    /// Weight w L³/B11 (vector).
+    pub weight: [f64; 3],
+    /// Stretching stiffness S of the discrete rod.
+    pub stiffness: f64,
+    /// The adaptive integrator's tolerance.
+    pub tolerance: f64,
+    /// N, 2N, 4N.
+    pub segments: [usize; 3],
 }
 
 /// The one-line verdict of a solution.
@@ -240,9 +406,15 @@ pub enum Verdict {
     DifferentEquilibrium {
         /// The other row (index).
         of: usize,
+        /// Some of its claims are refuted (the verdict line names them).
+        claims_refuted: bool,
     },
-    /// The discrete rod does not converge to the continuum solution.
-    MethodsDisagree,
+    /// The discrete rod does not converge to the continuum solution, or not
+    /// to one equilibrium as N grows.
+    MethodsDisagree {
+        /// Why.
+        why: Vec<Disagreement>,
+    },
     /// The claims are not what was found.
     ClaimsRefuted,
     /// Confirmed by both methods, with the claims.
@@ -270,6 +442,11 @@ pub struct SolutionCheck {
     pub rounding_units: Option<f64>,
     /// The continuum's judgement of the input.
     pub input: InputVerdict,
+    /// Why no solution was found near the input (the integration from it or
+    /// its Newton polish failed).
+    pub input_error: Option<String>,
+    /// The setting: the resolved scene's parameters, N and S.
+    pub setting: Option<Setting>,
     /// The fitted parameter, if asked.
     pub fit: Option<Fit>,
     /// Why the fit failed, if it did.
@@ -280,6 +457,13 @@ pub struct SolutionCheck {
     pub der: Vec<DerRow>,
     /// The extrapolated quantities against the continuum.
     pub estimates: Vec<Estimate>,
+    /// Stability from the extrapolated eigenvalues.
+    pub stability: Option<Stability>,
+    /// Why the two methods do not confirm each other (empty if they do).
+    pub disagreements: Vec<Disagreement>,
+    /// The first earlier row at the same parameters that polishes to the
+    /// same equilibrium.
+    pub same_as: Option<usize>,
     /// The claims checked.
     pub claims: Vec<ClaimCheck>,
     /// The verdict.
@@ -289,14 +473,42 @@ pub struct SolutionCheck {
 }
 
 impl SolutionCheck {
+    /// Nothing found yet about solution `s`, row `index`.
+    fn blank(index: usize, s: &Solution) -> SolutionCheck {
+        SolutionCheck {
+            index,
+            given: s.clone(),
+            law: String::new(),
+            end_residual: None,
+            polished: None,
+            polish_iterations: 0,
+            moved: None,
+            rounding_units: None,
+            input: InputVerdict::NoSolutionNearby,
+            input_error: None,
+            setting: None,
+            fit: None,
+            fit_error: None,
+            continuum_knot: None,
+            der: vec![],
+            estimates: vec![],
+            stability: None,
+            disagreements: vec![],
+            same_as: None,
+            claims: vec![],
+            verdict: Verdict::Failed(String::new()),
+            error: None,
+        }
+    }
+
     /// The estimate of a quantity.
     pub fn estimate(&self, q: Quantity) -> Option<&Estimate> {
         self.estimates.iter().find(|e| e.quantity == q)
     }
 
-    /// Negative directions at the finest N.
+    /// Negative directions of the extrapolated equilibrium, when decided.
     pub fn negative(&self) -> Option<usize> {
-        self.der.last().map(|d| d.negative)
+        self.stability.as_ref().and_then(Stability::negative)
     }
 }
 
@@ -316,7 +528,7 @@ pub fn scene_of(base: &Scene, s: &Solution, options: &VerifyOptions) -> Result<S
     scene.initial.from_recording = None;
     scene.initial.file = None;
     scene.initial.state = None;
-    scene.stability.eigenvalues = scene.stability.eigenvalues.max(1);
+    scene.stability.eigenvalues = scene.stability.eigenvalues.max(EIGENVALUES as i64);
     scene.validate()?;
     Ok(scene)
 }
@@ -353,6 +565,15 @@ const SATISFIED: f64 = 1e-8;
 const SAME_EQUILIBRIUM: f64 = 1e-6;
 /// Points of the continuum curve for its writhe and knot type.
 const CURVE_SAMPLES: usize = 1201;
+/// Eigenvalues computed at first (more when they are all negative).
+const EIGENVALUES: usize = 4;
+/// The most eigenvalues computed.
+const MAX_EIGENVALUES: usize = 100;
+/// A quantity that changes by less than this (relative) from N to 2N is
+/// converged already at N: its observed order is not checked (it is then
+/// set by round-off and the stiffness error, e.g. an ω² of −1771.7 that
+/// moves by 1e-5 relative at order 0.6).
+const RESOLVED: f64 = 1e-4;
 
 /// Verify one solution against `base`.
 pub fn verify_solution(
@@ -361,25 +582,7 @@ pub fn verify_solution(
     s: &Solution,
     options: &VerifyOptions,
 ) -> SolutionCheck {
-    let mut check = SolutionCheck {
-        index,
-        given: s.clone(),
-        law: String::new(),
-        end_residual: None,
-        polished: None,
-        polish_iterations: 0,
-        moved: None,
-        rounding_units: None,
-        input: InputVerdict::NoSolutionNearby,
-        fit: None,
-        fit_error: None,
-        continuum_knot: None,
-        der: vec![],
-        estimates: vec![],
-        claims: vec![],
-        verdict: Verdict::Failed(String::new()),
-        error: None,
-    };
+    let mut check = SolutionCheck::blank(index, s);
     if let Err(e) = run(base, s, options, &mut check) {
         let why = describe(&e);
         check.error = Some(why.clone());
@@ -399,17 +602,25 @@ fn run(
     let scene = scene_of(base, s, options).context("the solution's scene")?;
     let model = scene.rod_model(None);
     check.law = model.law.name().to_string();
+    check.setting = Some(setting_of(&scene, options));
     let continuum = continuum_of(&scene, options)?;
     let given = Unknowns::from(s.unknowns);
-    let at_given = continuum
-        .solve(&given, 0)
-        .context("integrating from the given unknowns")?;
+    // input that cannot be integrated or polished is no solution (a verdict
+    // on the input, not a failure of the check)
+    let at_given = match continuum.solve(&given, 0) {
+        Ok(a) => a,
+        Err(e) => {
+            check.input = InputVerdict::NoSolutionNearby;
+            check.input_error = Some(format!("integrating from the given unknowns: {e}"));
+            return Ok(());
+        }
+    };
     check.end_residual = Some(at_given.end_residual.into());
     let polished = match continuum.polish(&given) {
         Ok(p) => p,
         Err(e) => {
             check.input = InputVerdict::NoSolutionNearby;
-            check.error = Some(format!("polishing by Newton shooting: {e}"));
+            check.input_error = Some(format!("polishing by Newton shooting: {e}"));
             return Ok(());
         }
     };
@@ -447,6 +658,15 @@ fn run(
             Err(e) => check.fit_error = Some(describe(&e)),
         }
     }
+    if matches!(
+        check.input,
+        InputVerdict::Misses | InputVerdict::NoSolutionNearby
+    ) {
+        // the polished solution is another one: its rod and claims are not
+        // this row's
+        return Ok(());
+    }
+    let claimed_knot = s.claims.knot.as_deref().map(knot_claim).transpose()?;
     // the continuum curve's own topology and link
     let curve = continuum.solve(&polished.unknowns, CURVE_SAMPLES)?;
     let clamps = scene.clamps();
@@ -483,18 +703,23 @@ fn run(
     // the discrete rod from the polished shape at N, 2N, 4N
     let mut der_scene = scene.clone();
     set_unknowns(&mut der_scene, &polished.unknowns.into());
-    let mut eqs: Vec<Equilibrium> = Vec::new();
-    for n in options.segments {
-        let e = equilibrium_near_start(&der_scene, Some(n))
-            .with_context(|| format!("the discrete rod at N = {n}"))?;
-        check.der.push(der_row(n, &e));
-        eqs.push(e);
-    }
-    // the stretching penalty's model error, O(1/S): once more at N, S/10 (it hardly depends on N)
-    let mut softer = der_scene.clone();
-    softer.model.stretching_stiffness = Some(options.stretching_stiffness / 10.0);
-    let soft = equilibrium_near_start(&softer, Some(options.segments[0]))
-        .context("the discrete rod at N with a tenth of the stretching stiffness")?;
+    // as many eigenvalues as it takes to see a positive one
+    let (eqs, soft, stability) = loop {
+        let (eqs, soft) = discrete_rods(&der_scene, options)?;
+        let stability = stability_of(&eqs, &soft);
+        let computed = der_scene.stability.eigenvalues as usize;
+        if stability.as_ref().is_none_or(|s| s.complete) || computed >= MAX_EIGENVALUES {
+            break (eqs, soft, stability);
+        }
+        der_scene.stability.eigenvalues = (2 * computed).min(MAX_EIGENVALUES) as i64;
+    };
+    check.der = options
+        .segments
+        .iter()
+        .zip(&eqs)
+        .map(|(&n, e)| der_row(n, e))
+        .collect();
+    check.stability = stability;
     let values = |q: Quantity, e: &Equilibrium| -> Option<Vec<f64>> {
         Some(match q {
             Quantity::Force => e.n0.to_vec(),
@@ -528,8 +753,167 @@ fn run(
             c,
         ));
     }
-    check.claims = claims_checked(&s.claims, check);
+    check.disagreements = disagreements(check);
+    check.claims = claims_checked(&s.claims, claimed_knot.as_deref(), check);
     Ok(())
+}
+
+/// The discrete rod at N, 2N, 4N, and at N with a tenth of the stretching
+/// stiffness (its model error is O(1/S) and hardly depends on N).
+fn discrete_rods(
+    scene: &Scene,
+    options: &VerifyOptions,
+) -> Result<(Vec<Equilibrium>, Equilibrium)> {
+    let mut eqs = Vec::new();
+    for n in options.segments {
+        eqs.push(
+            equilibrium_near_start(scene, Some(n))
+                .with_context(|| format!("the discrete rod at N = {n}"))?,
+        );
+    }
+    let mut softer = scene.clone();
+    softer.model.stretching_stiffness = Some(options.stretching_stiffness / 10.0);
+    let soft = equilibrium_near_start(&softer, Some(options.segments[0]))
+        .context("the discrete rod at N with a tenth of the stretching stiffness")?;
+    Ok((eqs, soft))
+}
+
+/// The resolved scene's parameters, as the report's header states them.
+fn setting_of(scene: &Scene, options: &VerifyOptions) -> Setting {
+    let model = scene.rod_model(None);
+    let clamps = scene.clamps();
+    Setting {
+        clamps: Parameter::ALL
+            .iter()
+            .map(|&p| (p, p.value(&clamps)))
+            .collect(),
+        k2: model.k2,
+        k3: model.k3,
+        strip_epsilon: match model.law {
+            Law::Strip { regularisation } => Some(regularisation),
+            _ => None,
+        },
+        weight: model.weight,
+        stiffness: options.stretching_stiffness,
+        tolerance: options.tolerance,
+        segments: options.segments,
+    }
+}
+
+/// The extrapolated lowest eigenvalues (as many as every resolution and the
+/// softer rod computed), their signs and count.
+fn stability_of(eqs: &[Equilibrium], soft: &Equilibrium) -> Option<Stability> {
+    let k = eqs
+        .iter()
+        .chain([soft])
+        .map(|e| e.omega_squared.len())
+        .min()?;
+    if k == 0 {
+        return None;
+    }
+    let eigenvalues: Vec<Omega2> = (0..k)
+        .map(|i| {
+            let values = [
+                eqs[0].omega_squared[i],
+                eqs[1].omega_squared[i],
+                eqs[2].omega_squared[i],
+            ];
+            let (extrapolated, error, order) = richardson(&values.map(|v| vec![v]));
+            Omega2 {
+                values,
+                extrapolated: extrapolated[0],
+                error,
+                model_error: (soft.omega_squared[i] - values[0]).abs() / 9.0,
+                order,
+            }
+        })
+        .collect();
+    let count = |sign: Sign| eigenvalues.iter().filter(|e| e.sign() == sign).count();
+    Some(Stability {
+        negative: count(Sign::Negative),
+        undecided: count(Sign::Undecided),
+        complete: count(Sign::Positive) > 0,
+        eigenvalues,
+    })
+}
+
+/// Whether an observed order is checked: the quantity still changes from
+/// N to 2N by more than [`RESOLVED`].
+fn order_checked(values: &[Vec<f64>; 3]) -> bool {
+    distance(&values[0], &values[1]) > RESOLVED * norm(&values[2]).max(1.0)
+}
+
+/// Why the methods do not confirm each other: the continuum outside a
+/// bar, another knot type; or the discrete rod not one converging
+/// equilibrium (its knot type or, through an eigenvalue that does not
+/// converge, its inertia changes with N; an observed order outside
+/// [`ORDERS`]).
+fn disagreements(c: &SolutionCheck) -> Vec<Disagreement> {
+    let mut out = Vec::new();
+    let knots: Vec<Option<String>> = c.der.iter().map(|d| d.knot.clone()).collect();
+    if knots.windows(2).any(|w| w[0] != w[1]) {
+        out.push(Disagreement::KnotChangesWithN(knots));
+    }
+    let negative: Vec<usize> = c.der.iter().map(|d| d.negative).collect();
+    if negative.windows(2).any(|w| w[0] != w[1]) {
+        // the eigenvalues that cross zero must converge through it
+        let crossing = negative.iter().copied().max().unwrap_or(0);
+        let eigen = c.stability.as_ref().map_or(&[][..], |s| &s.eigenvalues[..]);
+        let converges = |e: &Omega2| ORDERS.contains(&e.order);
+        if eigen.len() < crossing || !eigen[..crossing].iter().all(converges) {
+            out.push(Disagreement::InertiaChangesWithN(negative));
+        }
+    }
+    for e in &c.estimates {
+        if order_checked(&e.values) && !ORDERS.contains(&e.order) {
+            out.push(Disagreement::Order {
+                quantity: e.quantity,
+                order: e.order,
+            });
+        }
+    }
+    for e in &c.estimates {
+        if e.agrees == Some(false) {
+            out.push(Disagreement::Differs(e.quantity));
+        }
+    }
+    let discrete = c.der.last().and_then(|d| d.knot.clone());
+    if c.continuum_knot != discrete {
+        out.push(Disagreement::Knot {
+            continuum: c.continuum_knot.clone(),
+            discrete,
+        });
+    }
+    out
+}
+
+/// Common names of knots, beside the table's own ("3_1", "4_1", …).
+const KNOT_ALIASES: [(&str, &str); 6] = [
+    ("unknot", "0_1"),
+    ("trefoil", "3_1"),
+    ("figure-eight", "4_1"),
+    ("figure eight", "4_1"),
+    ("figure-8", "4_1"),
+    ("cinquefoil", "5_1"),
+];
+
+/// A claimed knot type in the table's name ("trefoil" is "3_1"), or an
+/// error naming the field and the accepted forms.
+pub fn knot_claim(name: &str) -> Result<String> {
+    let trimmed = name.trim();
+    let canonical = KNOT_ALIASES
+        .iter()
+        .find(|(alias, _)| alias.eq_ignore_ascii_case(trimmed))
+        .map_or(trimmed, |(_, n)| *n);
+    if crate::geometry::knot::alexander_of(canonical).is_none() {
+        let aliases: Vec<&str> = KNOT_ALIASES.iter().map(|(a, _)| *a).collect();
+        fail!(
+            "claim knot = {name:?}: not a knot name; give a tabled knot (\"0_1\", \"3_1\", \"4_1\", … \
+             to 10 crossings), a sum of them (\"3_1#4_1\") or one of {}",
+            aliases.join(", ")
+        );
+    }
+    Ok(canonical.to_string())
 }
 
 fn der_row(n: usize, e: &Equilibrium) -> DerRow {
@@ -541,6 +925,7 @@ fn der_row(n: usize, e: &Equilibrium) -> DerRow {
         energy: e.energy,
         link: e.link,
         lowest_omega2: e.omega_squared.first().copied(),
+        omega_squared: e.omega_squared.clone(),
         negative: e.negative_eigenvalues,
         walled: e.walled,
         knot: e.knot_name.clone(),
@@ -561,14 +946,9 @@ fn norm(a: &[f64]) -> f64 {
 }
 
 /// Richardson extrapolation of three resolutions N, 2N, 4N of a second-order
-/// method, with the error estimate from the two extrapolations' difference,
-/// the model error `model` and the continuum's value with its own error.
-fn estimate(
-    quantity: Quantity,
-    values: [Vec<f64>; 3],
-    model: f64,
-    continuum: Option<(Vec<f64>, f64)>,
-) -> Estimate {
+/// method: the value R(2N, 4N), its error estimate |R(N, 2N) − R(2N, 4N)|
+/// and the observed order.
+fn richardson(values: &[Vec<f64>; 3]) -> (Vec<f64>, f64, f64) {
     let rich = |a: &[f64], b: &[f64]| -> Vec<f64> {
         a.iter().zip(b).map(|(x, y)| (4.0 * y - x) / 3.0).collect()
     };
@@ -576,6 +956,18 @@ fn estimate(
     let order = (distance(&values[0], &values[1]) / distance(&values[1], &values[2])).log2();
     // the solves' own accuracy sets a floor
     let error = distance(&r1, &r2).max(1e-10 * norm(&r2));
+    (r2, error, order)
+}
+
+/// A quantity's Richardson extrapolation with the model error `model`,
+/// against the continuum's value with its own error.
+fn estimate(
+    quantity: Quantity,
+    values: [Vec<f64>; 3],
+    model: f64,
+    continuum: Option<(Vec<f64>, f64)>,
+) -> Estimate {
+    let (r2, error, order) = richardson(&values);
     let difference = continuum.as_ref().map(|(c, _)| distance(c, &r2));
     let scale = norm(&r2).max(1e-300);
     let total = error + model + continuum.as_ref().map_or(0.0, |c| c.1);
@@ -595,25 +987,45 @@ fn estimate(
     }
 }
 
-fn claims_checked(claims: &Claims, check: &SolutionCheck) -> Vec<ClaimCheck> {
+fn claims_checked(
+    claims: &Claims,
+    claimed_knot: Option<&str>,
+    check: &SolutionCheck,
+) -> Vec<ClaimCheck> {
     let mut out = Vec::new();
     let finest = check.der.last();
+    // what rests on the discrete rod alone is undecided when it did not
+    // converge to one equilibrium
+    let converged = !check.disagreements.iter().any(|d| {
+        matches!(
+            d,
+            Disagreement::KnotChangesWithN(_)
+                | Disagreement::InertiaChangesWithN(_)
+                | Disagreement::Order { .. }
+        )
+    });
+    let decided = |confirmed: bool| match (converged, confirmed) {
+        (false, _) => ClaimOutcome::Undecided,
+        (true, true) => ClaimOutcome::Confirmed,
+        (true, false) => ClaimOutcome::Refuted,
+    };
     let number = |claim: &str, claimed: Printed, q: Quantity, out: &mut Vec<ClaimCheck>| {
         let Some(e) = check.estimate(q) else { return };
         let found = e.continuum.as_ref().unwrap_or(&e.extrapolated)[0];
         // a printed claim is good to one unit of its last digit (rounded or
-        // truncated), beside the found value's own error
+        // truncated), beside every error stated for the found value
         let unit = 2.0 * claimed.half_unit;
         let off = (found - claimed.value).abs();
+        let errors = e.error + e.model_error + e.continuum_error.unwrap_or(0.0);
+        let confirmed = off <= unit + BAR * errors;
         out.push(ClaimCheck {
             claim: claim.into(),
             claimed: format!("{}", claimed.value),
             found: format!(
-                "{found:.6} ± {:.1e} ({:.2} units of its last digit off)",
-                e.error + e.continuum_error.unwrap_or(0.0),
+                "{found:.6} ± {errors:.1e} ({:.2} units of its last digit off)",
                 off / unit
             ),
-            confirmed: off <= unit + 3.0 * (e.error + e.continuum_error.unwrap_or(0.0)),
+            outcome: decided(confirmed),
         });
     };
     if let Some(v) = claims.twist {
@@ -628,16 +1040,26 @@ fn claims_checked(claims: &Claims, check: &SolutionCheck) -> Vec<ClaimCheck> {
     if let Some(v) = claims.lowest_omega2 {
         number("lowest ω²", v, Quantity::LowestOmega2, &mut out);
     }
-    if let (Some(v), Some(d)) = (claims.stable, finest) {
+    if let Some(v) = claims.stable {
+        let stability = check.stability.as_ref();
+        let (outcome, found) = match stability.and_then(Stability::stable) {
+            Some(found) => (decided(found == v), found.to_string()),
+            None => (ClaimOutcome::Undecided, "undecided".to_string()),
+        };
+        let lowest = stability
+            .and_then(|s| s.eigenvalues.first())
+            .map_or("no eigenvalue computed".into(), |e| {
+                format!("lowest ω² {:.6} ± {:.1e}", e.extrapolated, e.bar())
+            });
+        let negative = stability.map_or(String::new(), |s| match s.negative() {
+            Some(k) => format!("{k} negative; "),
+            None => format!("{} negative, {} undecided; ", s.negative, s.undecided),
+        });
         out.push(ClaimCheck {
             claim: "stable".into(),
             claimed: v.to_string(),
-            found: format!(
-                "{} ({} negative)",
-                d.negative == 0 && check.der.iter().all(|r| r.negative == 0),
-                d.negative
-            ),
-            confirmed: v == check.der.iter().all(|r| r.negative == 0),
+            found: format!("{found} ({negative}{lowest})"),
+            outcome,
         });
     }
     if let (Some(v), Some(d)) = (claims.walled, finest) {
@@ -645,16 +1067,24 @@ fn claims_checked(claims: &Claims, check: &SolutionCheck) -> Vec<ClaimCheck> {
             claim: "walled".into(),
             claimed: v.to_string(),
             found: d.walled.to_string(),
-            confirmed: v == d.walled,
+            outcome: decided(v == d.walled),
         });
     }
-    if let Some(v) = &claims.knot {
+    if let (Some(given), Some(v)) = (&claims.knot, claimed_knot) {
         let found = finest.and_then(|d| d.knot.clone());
+        // the table names every knot of a polynomial, joined by " or "
+        let confirmed = found
+            .as_deref()
+            .is_some_and(|f| f.split(" or ").any(|n| n == v));
         out.push(ClaimCheck {
             claim: "knot".into(),
-            claimed: v.clone(),
-            found: found.clone().unwrap_or_else(|| "none".into()),
-            confirmed: found.as_deref() == Some(v.as_str()),
+            claimed: if given == v {
+                v.to_string()
+            } else {
+                format!("{given} ({v})")
+            },
+            found: found.unwrap_or_else(|| "none".into()),
+            outcome: decided(confirmed),
         });
     }
     out
@@ -668,12 +1098,12 @@ fn verdict_of(c: &SolutionCheck) -> Verdict {
         InputVerdict::NoSolutionNearby | InputVerdict::Misses => return Verdict::NotASolution,
         InputVerdict::Satisfies | InputVerdict::Rounded | InputVerdict::RoundedParameter => {}
     }
-    if c.estimates.iter().any(|e| e.agrees == Some(false))
-        || c.continuum_knot != c.der.last().and_then(|d| d.knot.clone())
-    {
-        return Verdict::MethodsDisagree;
+    if !c.disagreements.is_empty() {
+        return Verdict::MethodsDisagree {
+            why: c.disagreements.clone(),
+        };
     }
-    if c.claims.iter().any(|k| !k.confirmed) {
+    if c.claims.iter().any(ClaimCheck::refuted) {
         return Verdict::ClaimsRefuted;
     }
     Verdict::Confirmed
@@ -741,8 +1171,9 @@ fn fit(
 
 /// Verify all solutions (in parallel), reporting each as it is done (an
 /// error from `on_done` stops the run once the solutions in progress are
-/// done, and is returned); rows of the same parameters whose polished
-/// unknowns differ are marked as different equilibria.
+/// done, and is returned); rows at the same parameters are grouped by the
+/// equilibrium they polish to, and the rows of every group after the first
+/// marked as different equilibria from the first.
 pub fn verify_all(
     base: &Scene,
     solutions: &[Solution],
@@ -764,28 +1195,79 @@ pub fn verify_all(
             Ok(c)
         })
         .collect::<Result<_>>()?;
+    mark_equilibria(base, solutions, options, &mut checks);
+    Ok(checks)
+}
+
+/// The resolved scene a row is solved in, without its unknowns: rows with
+/// equal keys are at the same parameters, however they were given.
+fn parameters_key(base: &Scene, s: &Solution, options: &VerifyOptions) -> Option<String> {
+    let mut scene = scene_of(base, s, options).ok()?;
+    set_unknowns(&mut scene, &[0.0; 6]);
+    serde_json::to_string(&scene).ok()
+}
+
+/// Rows at the same parameters, grouped by the equilibrium they polish to
+/// (in row order): each row's first twin is `same_as`; the rows of the
+/// second and later groups are a different equilibrium from the first
+/// group's first row.
+fn mark_equilibria(
+    base: &Scene,
+    solutions: &[Solution],
+    options: &VerifyOptions,
+    checks: &mut [SolutionCheck],
+) {
+    let keys: Vec<Option<String>> = solutions
+        .iter()
+        .map(|s| parameters_key(base, s, options))
+        .collect();
+    // only solutions take part: a row that is none polishes to someone else's
+    let solution = |c: &SolutionCheck| {
+        matches!(
+            c.input,
+            InputVerdict::Satisfies | InputVerdict::Rounded | InputVerdict::RoundedParameter
+        ) && c.polished.is_some()
+    };
+    let same = |a: [f64; 6], b: [f64; 6]| {
+        let (a, b) = (Unknowns::from(a), Unknowns::from(b));
+        (a - b).norm() <= SAME_EQUILIBRIUM * a.norm().max(b.norm())
+    };
+    // per parameter key: the groups' first rows, in row order
+    let mut groups: Vec<(&String, Vec<usize>)> = Vec::new();
     for k in 0..checks.len() {
-        for j in 0..k {
-            let (a, b) = (&checks[j], &checks[k]);
-            if a.given.parameters != b.given.parameters {
-                continue;
+        let (Some(key), true) = (&keys[k], solution(&checks[k])) else {
+            continue;
+        };
+        let polished = checks[k].polished.unwrap_or_default();
+        let slot = match groups.iter().position(|(g, _)| *g == key) {
+            Some(i) => i,
+            None => {
+                groups.push((key, vec![]));
+                groups.len() - 1
             }
-            let (Some(pa), Some(pb)) = (a.polished, b.polished) else {
-                continue;
+        };
+        let firsts = &mut groups[slot].1;
+        let group = match firsts
+            .iter()
+            .position(|&f| same(checks[f].polished.unwrap_or_default(), polished))
+        {
+            Some(g) => {
+                checks[k].same_as = Some(firsts[g]);
+                g
+            }
+            None => {
+                firsts.push(k);
+                firsts.len() - 1
+            }
+        };
+        let c = &mut checks[k];
+        if group > 0 && matches!(c.verdict, Verdict::Confirmed | Verdict::ClaimsRefuted) {
+            c.verdict = Verdict::DifferentEquilibrium {
+                of: firsts[0],
+                claims_refuted: c.claims.iter().any(ClaimCheck::refuted),
             };
-            let (pa, pb) = (Unknowns::from(pa), Unknowns::from(pb));
-            if (pa - pb).norm() > SAME_EQUILIBRIUM * pa.norm().max(pb.norm())
-                && matches!(
-                    checks[k].verdict,
-                    Verdict::Confirmed | Verdict::ClaimsRefuted
-                )
-            {
-                checks[k].verdict = Verdict::DifferentEquilibrium { of: j };
-                break;
-            }
         }
     }
-    Ok(checks)
 }
 
 /// The shooting unknowns of a discrete equilibrium: its clamp reactions
@@ -822,4 +1304,93 @@ pub fn shooting_unknowns(
         residual: polished.residual,
         strip,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lowest_omega2(values: [f64; 3], model_error: f64) -> Estimate {
+        estimate(
+            Quantity::LowestOmega2,
+            values.map(|v| vec![v]),
+            model_error,
+            None,
+        )
+    }
+
+    #[test]
+    fn a_claimed_omega2_is_judged_against_every_stated_error() {
+        // the Appendix D knot at N = 200, 400, 800: Richardson 167.740942
+        // ± 9.5e-4, the stiffness error 3.2e-3; the true value is 167.7379
+        let mut check = SolutionCheck::blank(0, &solution());
+        let e = lowest_omega2([167.725924, 167.7379, 167.7401815], 3.2e-3);
+        assert!((e.error - 9.5e-4).abs() < 1e-5, "{e:?}");
+        assert!((e.extrapolated[0] - 167.740942).abs() < 1e-6, "{e:?}");
+        check.estimates.push(e);
+        let claim = |value: f64| Claims {
+            lowest_omega2: Some(Printed {
+                value,
+                half_unit: 5e-5,
+            }),
+            ..Claims::default()
+        };
+        let k = &claims_checked(&claim(167.7379), None, &check)[0];
+        assert_eq!(k.outcome, ClaimOutcome::Confirmed, "{k:?}");
+        // beyond those errors it is refuted
+        let k = &claims_checked(&claim(167.72), None, &check)[0];
+        assert_eq!(k.outcome, ClaimOutcome::Refuted, "{k:?}");
+    }
+
+    #[test]
+    fn an_order_far_from_two_is_a_disagreement_and_roundoff_is_not() {
+        // the strip at N = 400, 800, 1600: n(0) jumps at 1600
+        let mut check = SolutionCheck::blank(0, &solution());
+        check.estimates.push(estimate(
+            Quantity::Force,
+            [
+                vec![-8.43, 1.608, 72.08],
+                vec![-8.44, 1.61, 72.1],
+                vec![-3.91, 2.10, 55.2],
+            ],
+            0.0,
+            Some((vec![-8.43069, 1.60824, 72.0790], 1e-9)),
+        ));
+        // the link, exact to the solves' accuracy: no order
+        check.estimates.push(estimate(
+            Quantity::Link,
+            [vec![3.76], vec![3.76 + 3e-10], vec![3.76 + 2e-10]],
+            0.0,
+            Some((vec![3.76], 1e-6)),
+        ));
+        let why = disagreements(&check);
+        assert_eq!(why.len(), 1, "{why:?}");
+        assert!(
+            matches!(why[0], Disagreement::Order { quantity: Quantity::Force, order } if order < -8.0),
+            "{why:?}"
+        );
+    }
+
+    #[test]
+    fn knot_claims_take_common_names_and_refuse_unknown_ones() {
+        assert_eq!(knot_claim("trefoil").unwrap(), "3_1");
+        assert_eq!(knot_claim("Figure-Eight").unwrap(), "4_1");
+        assert_eq!(knot_claim("3_1#4_1").unwrap(), "3_1#4_1");
+        let e = describe(&knot_claim("granny knot").unwrap_err());
+        assert!(
+            e.contains("claim knot") && e.contains("3_1") && e.contains("unknot"),
+            "{e}"
+        );
+    }
+
+    fn solution() -> Solution {
+        Solution {
+            name: "row".into(),
+            parameters: vec![],
+            parameter_rounding: vec![],
+            unknowns: [0.0; 6],
+            rounding: [1e-9; 6],
+            claims: Claims::default(),
+        }
+    }
 }
