@@ -3,10 +3,12 @@
 //! three resolutions; a table on the terminal, JSON and a markdown report.
 
 use super::progress::Progress;
+use crate::io::auto::{is_auto_input, read_auto_input};
 use crate::io::convergence_plot::{Series, convergence_plot};
 use crate::io::json::write_pretty;
 use crate::io::verify_file::read_solutions;
 use crate::model::rod::Parameter;
+use crate::report::auto_events::{self, compare_with_continuation};
 use crate::report::verify::{details, markdown, summary};
 use crate::scene::{InitialShape, Job, Scene, human_time};
 use crate::study::verify::{Quantity, SolutionCheck, VerifyOptions, verify_all};
@@ -18,8 +20,15 @@ use std::path::PathBuf;
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// The solutions (TOML `[[solution]]`, JSON `{"solution": [...]}` or
-    /// CSV, one row each).
+    /// CSV, one row each), or AUTO-07p's: a TOML file with an `[auto]`
+    /// mapping, or its `s.NAME` / `fort.8` itself with `--map`.
     pub file: PathBuf,
+    /// For AUTO-07p files: which AUTO unknowns and parameters are knotrod's,
+    /// e.g. `--map n0=13,14,15 --map m0=16,17,18 --map phi=1:turns` (φ's
+    /// unit: radians or turns, φ/2π), `--map branch=b.NAME`,
+    /// `--map continuation=scene.toml` (its events beside AUTO's LP and BP).
+    #[arg(long)]
+    pub map: Vec<String>,
     /// The base scene (model and clamps); overrides the file's `scene`.
     #[arg(long)]
     pub scene: Option<PathBuf>,
@@ -138,7 +147,19 @@ pub fn verify(a: Args) -> Result<()> {
         stretching_stiffness: a.stiffness,
         ..VerifyOptions::default()
     };
-    let (base, solutions) = read_solutions(&a.file, a.scene.as_deref())?;
+    let auto = if is_auto_input(&a.file) {
+        Some(read_auto_input(&a.file, a.scene.as_deref(), &a.map)?)
+    } else {
+        ensure!(
+            a.map.is_empty(),
+            "--map: only for AUTO-07p files (s.NAME, fort.8, or TOML with [auto])"
+        );
+        None
+    };
+    let (base, solutions) = match &auto {
+        Some(x) => (x.scene.clone(), x.solutions.clone()),
+        None => read_solutions(&a.file, a.scene.as_deref())?,
+    };
     // more threads than cores only cost memory (and 10⁵ threads cost the machine)
     let threads = a.threads.map_or(cores(), |t| t.clamp(1, cores()));
     if let Some(t) = a.threads.filter(|t| *t > threads) {
@@ -175,6 +196,15 @@ pub fn verify(a: Args) -> Result<()> {
             write!(out, "{}", details(c, &checks))?;
         }
     }
+    // AUTO's folds and branch points beside knotrod's events on its branch
+    let labelled = match &auto {
+        Some(x) => Some(auto_events::markdown(&compare_with_continuation(x)?)),
+        None => None,
+    };
+    if let Some(section) = &labelled {
+        writeln!(out)?;
+        write!(out, "{section}")?;
+    }
     if let Some(p) = &a.json {
         write_pretty(p, &checks)?;
         eprintln!("wrote {}", p.display());
@@ -196,13 +226,17 @@ pub fn verify(a: Args) -> Result<()> {
             .enumerate()
             .map(|(k, a)| if k == 0 { "knotrod".into() } else { a })
             .collect();
-        let text = markdown(
+        let mut text = markdown(
             &command.join(" "),
             &a.file.display().to_string(),
             &checks,
             options.segments,
             drawn.then_some(name.as_str()),
         );
+        if let Some(section) = &labelled {
+            text.push('\n');
+            text.push_str(section);
+        }
         crate::io::output::write_file(p, text.as_bytes())?;
         eprintln!("wrote {}", p.display());
     }

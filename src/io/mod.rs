@@ -1,6 +1,8 @@
 //! Files: scene files, restart states, MCAP recordings (writer, reader,
-//! Foxglove geometry), JSON summaries and map files, plots, exports.
+//! Foxglove geometry), JSON summaries and map files, plots, exports, and
+//! AUTO-07p's output for verify.
 
+pub mod auto;
 pub mod convergence_plot;
 pub mod curve_file;
 pub mod error;

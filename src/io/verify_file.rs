@@ -65,6 +65,15 @@ pub enum VerifyFileError {
     /// The base scene could not be read.
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// Not a format verify reads.
+    #[error(
+        "{path}: not a format verify reads; supported: {}",
+        crate::io::auto::SUPPORTED_FORMATS
+    )]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
 }
 
 /// A value as written: numbers keep half a unit of their last digit.
@@ -368,7 +377,8 @@ pub fn read_solutions(
     let (named, rows) = match ext.as_str() {
         "json" => parse_json(path, &text)?,
         "csv" => parse_csv(path, &text)?,
-        _ => parse_toml(path, &text)?,
+        "toml" => parse_toml(path, &text)?,
+        _ => return Err(VerifyFileError::UnknownFormat { path: path.into() }),
     };
     if rows.len() > MAX_SOLUTIONS {
         return Err(VerifyFileError::TooMany {

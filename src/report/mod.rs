@@ -2,6 +2,7 @@
 //! checks, and the benchmark.
 
 pub mod analytic;
+pub mod auto_events;
 pub mod bench;
 pub mod error;
 pub mod validation;
