@@ -481,6 +481,41 @@ fn hold_contacts(
     Some(wide)
 }
 
+/// Ratio of the second penalty to the law's own in [`stability_in_the_limit`].
+const PENALTY_RATIO: f64 = 10.0;
+
+/// The spectrum of [`stability`], for a constrained law (the strip's u2 = 0)
+/// taken to the constraint itself: the augmented Lagrangian's Hessian, the
+/// Lagrangian's plus ρ JᵀJ, has the constrained eigenvalues only as ρ → ∞,
+/// each off by c/ρ (ρ = PENALTY/h holds the discrete strip 5e-4 below its
+/// continuum ω², a bias that N does not remove). Computed at ρ and 10ρ, the
+/// values are extrapolated as λ(10ρ) + (λ(10ρ) − λ(ρ))/9, the inertia is
+/// the one at 10ρ. An unconstrained law has one spectrum.
+fn stability_in_the_limit(
+    newton: &mut Minimizer,
+    state: &RodState,
+    report: &SolveReport,
+    k: usize,
+    hessian: Option<&[f64]>,
+) -> Result<(Spectrum, Vec<f64>), AnalysisError> {
+    let Some(rho) = newton.energy.penalty else {
+        return stability(newton, state, report, k, hessian);
+    };
+    let (plain, pencil) = stability(newton, state, report, k, hessian)?;
+    newton.energy.penalty = Some(PENALTY_RATIO * rho);
+    let stiffer = stability(newton, state, report, k, None);
+    newton.energy.penalty = Some(rho);
+    let (mut stiff_plain, stiff_pencil) = stiffer?;
+    let limit = |a: &[f64], b: &[f64]| -> Vec<f64> {
+        a.iter()
+            .zip(b)
+            .map(|(lo, hi)| hi + (hi - lo) / (PENALTY_RATIO - 1.0))
+            .collect()
+    };
+    stiff_plain.values = limit(&plain.values, &stiff_plain.values);
+    Ok((stiff_plain, limit(&pencil, &stiff_pencil)))
+}
+
 /// The spectrum at an equilibrium: the Hessian's (contacts held) lowest `k`
 /// eigenvalues and inertia, and the pencil's with the lumped mass (the ω²).
 /// `hessian` is the Hessian at `state` when the caller has it already.
@@ -606,7 +641,8 @@ pub fn analyse_from(
     previous: Option<&Equilibrium>,
     hessian: Option<&[f64]>,
 ) -> Result<Equilibrium, AnalysisError> {
-    let (plain, pencil_values) = stability(newton, state, report, measure.eigenvalues, hessian)?;
+    let (plain, pencil_values) =
+        stability_in_the_limit(newton, state, report, measure.eigenvalues, hessian)?;
     let reactions = newton.energy.clamp_reactions(state);
     let Walls {
         min_z,
