@@ -27,10 +27,7 @@ pub const MAX_DIM: usize = 10_000;
 /// Most parameters (NPAR) read.
 pub const MAX_PAR: usize = 10_000;
 
-/// The formats `knotrod verify` reads, for messages naming them.
-pub const SUPPORTED_FORMATS: &str = "TOML (.toml: [[solution]] rows, or an [auto] mapping of \
-     AUTO-07p files), JSON (.json), CSV (.csv), AUTO-07p's solutions s.NAME or fort.8 (with \
-     --map, beside its branch b.NAME or fort.7)";
+pub use crate::io::verify_file::SUPPORTED_FORMATS;
 
 /// Why AUTO-07p files or their mapping could not be used.
 #[derive(Debug, thiserror::Error)]

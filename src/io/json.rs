@@ -20,10 +20,4 @@ pub fn write_pretty_to<T: Serialize + ?Sized>(out: Output, value: &T) -> Result<
     out.put(text.as_bytes())
 }
 
-/// Create the folder holding `path` (if it names one).
-pub fn create_parent(path: &Path) -> Result<()> {
-    match path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        Some(dir) => std::fs::create_dir_all(dir).map_err(IoError::file("creating folder", dir)),
-        None => Ok(()),
-    }
-}
+pub use crate::io::output::create_parent;

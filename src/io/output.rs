@@ -74,7 +74,7 @@ impl Output {
     /// Start writing `path` (its folder created if need be): refused if
     /// `path` is a folder or another writer holds it.
     pub fn create(path: &Path) -> Result<Self> {
-        crate::io::json::create_parent(path)?;
+        create_parent(path)?;
         if path.is_dir() {
             return Err(IoError::Refused {
                 path: path.into(),
@@ -213,6 +213,14 @@ impl Drop for Output {
 /// Write `bytes` as the whole of `path`, atomically (see [`Output`]).
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     Output::create(path)?.put(bytes)
+}
+
+/// Create the folder holding `path` (if it names one).
+pub fn create_parent(path: &Path) -> Result<()> {
+    match path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(dir) => std::fs::create_dir_all(dir).map_err(IoError::file("creating folder", dir)),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]

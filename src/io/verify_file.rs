@@ -17,6 +17,11 @@ use std::path::{Path, PathBuf};
 /// Largest number of solutions in one file.
 pub const MAX_SOLUTIONS: usize = 100_000;
 
+/// The formats `knotrod verify` reads, for messages naming them.
+pub const SUPPORTED_FORMATS: &str = "TOML (.toml: [[solution]] rows, or an [auto] mapping of \
+     AUTO-07p files), JSON (.json), CSV (.csv), AUTO-07p's solutions s.NAME or fort.8 (with \
+     --map, beside its branch b.NAME or fort.7)";
+
 /// Why a file of solutions could not be used.
 #[derive(Debug, thiserror::Error)]
 pub enum VerifyFileError {
@@ -66,10 +71,7 @@ pub enum VerifyFileError {
     #[error(transparent)]
     Scene(#[from] SceneError),
     /// Not a format verify reads.
-    #[error(
-        "{path}: not a format verify reads; supported: {}",
-        crate::io::auto::SUPPORTED_FORMATS
-    )]
+    #[error("{path}: not a format verify reads; supported: {}", SUPPORTED_FORMATS)]
     UnknownFormat {
         /// The file.
         path: PathBuf,

@@ -144,6 +144,13 @@ fn disagreement(d: &Disagreement) -> String {
             knot(continuum),
             knot(discrete)
         ),
+        Disagreement::Inertia {
+            continuum,
+            discrete,
+        } => format!(
+            "the negative directions (continuum {continuum} by conjugate points, discrete rod \
+             {discrete})"
+        ),
         Disagreement::KnotChangesWithN(k) => format!(
             "the discrete rod's knot type changes with N ({}): not one equilibrium",
             k.iter().map(knot).collect::<Vec<_>>().join(" / ")

@@ -206,7 +206,8 @@ pub struct Estimate {
     pub model_error: f64,
     /// The continuum value's own error (the writhe's sampling, for the link).
     pub continuum_error: Option<f64>,
-    /// The continuum's value (None for ω²).
+    /// The continuum's value (for ω², its shooting determinant's, where
+    /// both ends are clamped).
     pub continuum: Option<Vec<f64>>,
     /// |continuum − extrapolated| (norm).
     pub difference: Option<f64>,
@@ -356,6 +357,14 @@ pub enum Disagreement {
         /// The discrete rod's at 4N.
         discrete: Option<String>,
     },
+    /// The continuum's count of negative directions (conjugate points) is
+    /// not the discrete rod's extrapolated one.
+    Inertia {
+        /// The continuum's.
+        continuum: usize,
+        /// The discrete rod's.
+        discrete: usize,
+    },
     /// The discrete rod's knot type changes with N: the three resolutions
     /// are not one equilibrium.
     KnotChangesWithN(Vec<Option<String>>),
@@ -453,6 +462,10 @@ pub struct SolutionCheck {
     pub fit_error: Option<String>,
     /// Knot of the continuum curve's ray closure.
     pub continuum_knot: Option<String>,
+    /// Eigenvalues ω² < 0 of the continuum's (A.4), counted by conjugate
+    /// points (None where the continuum's stability is not covered).
+    #[serde(default)]
+    pub continuum_negative: Option<usize>,
     /// The discrete rod at N, 2N, 4N.
     pub der: Vec<DerRow>,
     /// The extrapolated quantities against the continuum.
@@ -490,6 +503,7 @@ impl SolutionCheck {
             fit: None,
             fit_error: None,
             continuum_knot: None,
+            continuum_negative: None,
             der: vec![],
             estimates: vec![],
             stability: None,
@@ -684,7 +698,7 @@ fn run(
     let coarse = writhe(&half);
     let writhe = fine + (fine - coarse) / 3.0;
     let tiny = |v: f64| 1e-10 * v.abs().max(1.0);
-    let continuum_values = [
+    let mut continuum_values = vec![
         (
             Quantity::Force,
             (curve.n0.as_slice().to_vec(), tiny(curve.n0.norm())),
@@ -720,6 +734,18 @@ fn run(
         .map(|(&n, e)| der_row(n, e))
         .collect();
     check.stability = stability;
+    // stability on the continuum, by the shooting determinant of (A.4) and
+    // its conjugate points: the second method for ω² and the inertia (only
+    // where both ends are clamped; elsewhere the discrete rod's alone)
+    if let Some(lowest) = eqs.last().and_then(|e| e.omega_squared.first()) {
+        if let Ok(spectrum) = continuum.lowest_frequencies(&polished.unknowns, 1, lowest.abs()) {
+            continuum_values.push((
+                Quantity::LowestOmega2,
+                (spectrum.values.clone(), spectrum.errors[0]),
+            ));
+            check.continuum_negative = Some(spectrum.negative);
+        }
+    }
     let values = |q: Quantity, e: &Equilibrium| -> Option<Vec<f64>> {
         Some(match q {
             Quantity::Force => e.n0.to_vec(),
@@ -876,6 +902,15 @@ fn disagreements(c: &SolutionCheck) -> Vec<Disagreement> {
         if e.agrees == Some(false) {
             out.push(Disagreement::Differs(e.quantity));
         }
+    }
+    let decided = c.stability.as_ref().and_then(Stability::negative);
+    if let (Some(continuum), Some(discrete)) = (c.continuum_negative, decided)
+        && continuum != discrete
+    {
+        out.push(Disagreement::Inertia {
+            continuum,
+            discrete,
+        });
     }
     let discrete = c.der.last().and_then(|d| d.knot.clone());
     if c.continuum_knot != discrete {
