@@ -485,6 +485,9 @@ fn lowest_with(
     })
 }
 
+/// Eigenpairs (value, vector on the free dofs), ascending.
+type Modes = Vec<(f64, Vec<f64>)>;
+
 /// The matrix H − σM of the problem at its shift.
 struct Shifted<'a> {
     pattern: &'a SymmetricPattern,
@@ -500,10 +503,10 @@ struct Shifted<'a> {
 /// independent in the mass norm; an error when the form is not finite.
 fn rayleigh_ritz(
     a: &Shifted<'_>,
-    modes: &[(f64, Vec<f64>)],
+    modes: &Modes,
     ldlt: &mut Ldlt,
     gram: Gram<'_>,
-) -> Result<Option<Vec<(f64, Vec<f64>)>>, StabilityError> {
+) -> Result<Option<Modes>, StabilityError> {
     let k = modes.len();
     if k == 0 {
         return Ok(None);

@@ -179,12 +179,12 @@ pub(super) fn section(d: &Scene) -> Result<String> {
         let mut line = format!("| {} → {n} ", table[k - 1].0);
         for c in 0..fine.len() {
             let r = (4.0 * fine[c] - coarse[c]) / 3.0;
-            let p = (k >= 2)
-                .then(|| {
-                    let older = &table[k - 2].1;
-                    super::format::order((coarse[c] - older[c]).abs(), (fine[c] - coarse[c]).abs())
-                })
-                .unwrap_or_default();
+            let p = if k >= 2 {
+                let older = &table[k - 2].1;
+                super::format::order((coarse[c] - older[c]).abs(), (fine[c] - coarse[c]).abs())
+            } else {
+                String::new()
+            };
             line += &format!("| {r:.6} | {p} ");
         }
         writeln!(s, "{line}|")?;
