@@ -1,7 +1,8 @@
 //! Knot types and writhe of closed curves.
 
 use knotrod::geometry::knot::{KnotError, knot_type, knot_type_along};
-use knotrod::geometry::writhe::writhe_closed;
+use knotrod::geometry::polyline::{CurveError, parse_points};
+use knotrod::geometry::writhe::{segment_pair_writhe, try_writhe_closed, writhe_closed};
 use nalgebra::{Rotation3, Vector3};
 use std::f64::consts::PI;
 
@@ -373,4 +374,128 @@ fn a_dense_curve_and_degenerate_input_are_handled() {
     let mut bad = torus(2.0, 3.0, 50);
     bad[7].y = f64::NAN;
     assert!(matches!(knot_type(&bad), Err(KnotError::NotFinite(7))));
+}
+
+#[test]
+fn knot_type_and_writhe_do_not_depend_on_scale() {
+    // a 300-point trefoil at 1e100 read as the unknot (products of
+    // coordinates overflowed), at 1e200 had no generic projection, at 1e-300
+    // collapsed to one point when read from text
+    let trefoil = torus(2.0, 3.0, 300);
+    let w1 = writhe_closed(&trefoil);
+    for scale in [1e-300, 1e-100, 1.0, 1e100, 1e150, 1e200, 1e300] {
+        for shift in [0.0, 1e3] {
+            let p: Vec<Vector3<f64>> = trefoil
+                .iter()
+                .map(|q| scale * (q + Vector3::repeat(shift)))
+                .collect();
+            let k = knot_type(&p).unwrap_or_else(|e| panic!("×{scale:e}: {e}"));
+            assert_eq!(k.determinant, 3, "×{scale:e} +{shift}: {k:?}");
+            assert_eq!(k.name.as_deref(), Some("3_1"), "×{scale:e}: {k:?}");
+            let w = writhe_closed(&p);
+            assert!(
+                (w - w1).abs() < 1e-9,
+                "×{scale:e} +{shift}: writhe {w}, {w1} at 1"
+            );
+        }
+        let text: String = trefoil
+            .iter()
+            .map(|q| format!("{:e} {:e} {:e}\n", scale * q.x, scale * q.y, scale * q.z))
+            .collect();
+        assert_eq!(parse_points(&text).unwrap().len(), 300, "×{scale:e}");
+    }
+}
+
+/// n points on the trefoil T(2,3), each moved by up to a quarter of the
+/// shortest step in each coordinate (seeded): consecutive segments but one
+/// then stay apart along the tangent all the way along the straight
+/// homotopy to the smooth curve, so the noisy polygon is still a trefoil.
+fn noisy_trefoil(n: usize, seed: u64) -> Vec<Vector3<f64>> {
+    let smooth = torus(2.0, 3.0, n);
+    let step = (0..n)
+        .map(|k| (smooth[(k + 1) % n] - smooth[k]).norm())
+        .fold(f64::INFINITY, f64::min);
+    let mut rng = Lcg(seed);
+    smooth
+        .into_iter()
+        .map(|p| p + 0.25 * step * Vector3::new(rng.next(), rng.next(), rng.next()))
+        .collect()
+}
+
+#[test]
+fn long_noisy_curves_keep_their_knot_and_exact_writhe() {
+    // the writhe of a long curve comes from one projection: the same as the
+    // sum over all segment pairs
+    let p = noisy_trefoil(3000, 3);
+    let m = p.len();
+    let mut pairs = 0.0;
+    for i in 0..m {
+        for j in i + 2..m {
+            if !(i == 0 && j == m - 1) {
+                pairs += segment_pair_writhe(&p[i], &p[i + 1], &p[j], &p[(j + 1) % m]);
+            }
+        }
+    }
+    let w = writhe_closed(&p);
+    assert!(
+        (w - 2.0 * pairs).abs() < 1e-9,
+        "{w} by projection, {} by pairs",
+        2.0 * pairs
+    );
+    // 10⁵ points (10⁶ in `knotrod bench`): the trefoil, and a writhe
+    let p = noisy_trefoil(100_000, 5);
+    let k = knot_type(&p).unwrap();
+    assert_eq!(k.name.as_deref(), Some("3_1"), "{k:?}");
+    assert!(k.vertices < 50, "{} vertices left", k.vertices);
+    let w = try_writhe_closed(&p).unwrap();
+    assert!(w.is_finite() && w.abs() < 20.0, "writhe {w}");
+    assert_eq!(w, writhe_closed(&p));
+}
+
+#[test]
+fn a_curve_too_tangled_for_the_budget_is_refused_with_an_estimate() {
+    // 10⁵ points in a box: some 10⁹ overlapping segment pairs to sweep and
+    // O(n²) simplification; a clear error rather than minutes or hours
+    let mut rng = Lcg(17);
+    let cloud: Vec<Vector3<f64>> = (0..100_000)
+        .map(|_| Vector3::new(rng.next(), rng.next(), rng.next()))
+        .collect();
+    for e in [
+        knot_type(&cloud).unwrap_err(),
+        try_writhe_closed(&cloud).unwrap_err(),
+    ] {
+        match e {
+            KnotError::TooLong { pairs, seconds } => {
+                assert!(pairs > 2e9 && seconds > 10.0, "{e}")
+            }
+            other => panic!("{other}"),
+        }
+    }
+}
+
+#[test]
+fn a_curve_file_header_must_name_its_columns() {
+    for header in [
+        "x y z",
+        "x,y,z",
+        "X; Y; Z",
+        "\"x\",\"y\",\"z\"",
+        "# a comment\nx y z",
+    ] {
+        let text = format!("{header}\n0 0 0\n1 0 0\n0 1 0\n");
+        assert_eq!(parse_points(&text).unwrap().len(), 3, "{header}");
+    }
+    // a typo in the first point was taken for a header and the point dropped
+    for (text, line) in [
+        ("0 0 O\n1 0 0\n0 1 0\n0 0 1\n", 1),
+        ("x y z\n0 0 O\n1 0 0\n0 1 0\n0 0 1\n", 2),
+        ("# c\n\n1,2,3e\n1 0 0\n0 1 0\n0 0 1\n", 3),
+        ("x y z\nx y z\n1 0 0\n0 1 0\n0 0 1\n", 2),
+        ("x y\n1 0 0\n0 1 0\n0 0 1\n", 1),
+    ] {
+        match parse_points(text) {
+            Err(CurveError::Line { line: l, .. }) => assert_eq!(l, line, "{text:?}"),
+            other => panic!("{text:?}: {other:?}"),
+        }
+    }
 }

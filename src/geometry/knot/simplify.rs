@@ -17,6 +17,12 @@ use nalgebra::Vector3;
 /// every query scans (the long closing rays, the far loop).
 const LARGE: i64 = 64;
 
+/// Most candidate segments tested against triangles in one simplification
+/// (a 10⁶-point noisy curve needs 5·10⁷; a curve that fills a box needs
+/// O(n²)): past it the polygon is returned as far as it got, which is still
+/// the same knot, and the diagram's own limits decide.
+const MOST_CANDIDATES: usize = 300_000_000;
+
 /// End of a bucket's list.
 const NONE: u32 = u32::MAX;
 
@@ -305,7 +311,8 @@ pub(super) fn simplify(points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
     // cells are `coarsen` times the median segment: raised when a pass could
     // only defer (every removal would have made a segment too long for it)
     let mut coarsen = 1.0;
-    loop {
+    let mut candidates = 0;
+    'passes: loop {
         let order = cyc.vertices(start);
         let mut lengths: Vec<f64> = order
             .iter()
@@ -322,8 +329,8 @@ pub(super) fn simplify(points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
         let before = cyc.alive;
         let mut deferred = false;
         for &b in &order {
-            if cyc.alive <= 3 {
-                break;
+            if cyc.alive <= 3 || candidates > MOST_CANDIDATES {
+                break 'passes;
             }
             let (a, c) = (cyc.prev[b], cyc.next[b]);
             let (pa, pb, pc) = (&cyc.p[a], &cyc.p[b], &cyc.p[c]);
@@ -344,6 +351,7 @@ pub(super) fn simplify(points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
                 near.clear();
                 near.extend(cyc.vertices(c).into_iter().map(|v| v as u32));
             }
+            candidates += near.len();
             let (z, d) = (cyc.prev[a], c);
             let blocked = near.iter().any(|&s| {
                 let s = s as usize;
