@@ -20,7 +20,8 @@ def main(table: str = str(ROOT / "scenes/verify/two_equilibria.toml"), n: int = 
         name = c["given"]["name"]
         print(f"{name}: {c['verdict']}")
         for claim in c.get("claims", []):
-            mark = "confirmed" if claim["confirmed"] else "REFUTED"
+            # Confirmed, Refuted, or Undecided (the error bar straddles it)
+            mark = {"Confirmed": "confirmed", "Refuted": "REFUTED"}.get(claim["outcome"], "undecided")
             print(f"   claims {claim['claim']} = {claim['claimed']}: found {claim['found']} ({mark})")
     return checks
 
