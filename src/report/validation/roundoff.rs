@@ -48,8 +48,15 @@ fn row(name: &str, n: usize, stiffness: Option<f64>, text: &str) -> Result<Strin
     let (newton, state, report) = match starting_equilibrium(&scene, None) {
         Ok(solved) => solved,
         Err(e) => {
+            // the whole chain: the step and why it failed
+            let mut why = e.to_string();
+            let mut source = std::error::Error::source(&e);
+            while let Some(s) = source {
+                why += &format!(": {s}");
+                source = s.source();
+            }
             return Ok(format!(
-                "| {name} | {n} | {stiffness} | — | not reached: {e} | | | | | |\n"
+                "| {name} | {n} | {stiffness} | — | not reached: {why} | | | | | |\n"
             ));
         }
     };
