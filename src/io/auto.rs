@@ -640,8 +640,8 @@ impl AutoMap {
                         return Err(bad(k, format!("{} indices; give three [i, j, k]", v.len())));
                     }
                     once(map.unknowns[base].is_some())?;
-                    for c in 0..3 {
-                        map.unknowns[base + c] = Some(index(k, v[c])?);
+                    for (c, &u) in v.iter().enumerate() {
+                        map.unknowns[base + c] = Some(index(k, u)?);
                     }
                 }
                 "u1_0" | "m2_0" | "u3_0" => {

@@ -204,9 +204,14 @@ pub fn judge(
     }
 }
 
-/// Iterates near the floor (where it was measured) after which a gradient
-/// that has not halved is stalled.
+/// Iterates near the floor after which a gradient that has not halved is
+/// stalled.
 const STALL_ITERATIONS: usize = 20;
+
+/// How near its floor a gradient must be for its failure to decrease to be
+/// the rounding's: further up, a slow approach (capped steps from far away)
+/// is progress, and the iteration budget judges it.
+const NEAR_FLOOR: f64 = 4.0;
 
 /// Watches for a gradient that stops decreasing above its measured floor, so
 /// that such a solve ends with [`SolveError::RoundOff`] instead of running
@@ -220,7 +225,7 @@ pub struct Stall {
 impl Stall {
     /// Account for iterate `iteration`; the error once stalled.
     pub fn check(&mut self, iteration: usize, j: &Judgement) -> Result<(), SolveError> {
-        let Some(floor) = j.floor else {
+        let Some(floor) = j.floor.filter(|f| j.gradient <= NEAR_FLOOR * f) else {
             return Ok(());
         };
         match self.best {

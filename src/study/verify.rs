@@ -737,14 +737,14 @@ fn run(
     // stability on the continuum, by the shooting determinant of (A.4) and
     // its conjugate points: the second method for ω² and the inertia (only
     // where both ends are clamped; elsewhere the discrete rod's alone)
-    if let Some(lowest) = eqs.last().and_then(|e| e.omega_squared.first()) {
-        if let Ok(spectrum) = continuum.lowest_frequencies(&polished.unknowns, 1, lowest.abs()) {
-            continuum_values.push((
-                Quantity::LowestOmega2,
-                (spectrum.values.clone(), spectrum.errors[0]),
-            ));
-            check.continuum_negative = Some(spectrum.negative);
-        }
+    if let Some(lowest) = eqs.last().and_then(|e| e.omega_squared.first())
+        && let Ok(spectrum) = continuum.lowest_frequencies(&polished.unknowns, 1, lowest.abs())
+    {
+        continuum_values.push((
+            Quantity::LowestOmega2,
+            (spectrum.values.clone(), spectrum.errors[0]),
+        ));
+        check.continuum_negative = Some(spectrum.negative);
     }
     let values = |q: Quantity, e: &Equilibrium| -> Option<Vec<f64>> {
         Some(match q {
