@@ -499,3 +499,17 @@ fn a_curve_file_header_must_name_its_columns() {
         }
     }
 }
+
+#[test]
+fn a_curve_whose_points_rounding_makes_coincide_is_answered_at_once() {
+    // found by the curve_text fuzz target: one coordinate 5.6e197 beside
+    // ones of order 1, so unit sizing rounds the small ones onto one point;
+    // the simplification's median segment was 0 and its passes never ended
+    let out = common::knotrod(&[
+        "knot",
+        "tests/fixtures/curve_collapsing_points.txt",
+        "--closed",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("knot type"), "{err}");
+}

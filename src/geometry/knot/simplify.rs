@@ -85,7 +85,11 @@ impl Grid {
     }
 
     fn span(lo: Cell, hi: Cell) -> i64 {
-        (hi.0 - lo.0 + 1) as i64 * (hi.1 - lo.1 + 1) as i64 * (hi.2 - lo.2 + 1) as i64
+        // in i64: cell indices near i32's ends must not wrap to a small span
+        let side = |a: i32, b: i32| (b as i64 - a as i64 + 1).max(0);
+        side(lo.0, hi.0)
+            .saturating_mul(side(lo.1, hi.1))
+            .saturating_mul(side(lo.2, hi.2))
     }
 
     fn cells(lo: Cell, hi: Cell) -> impl Iterator<Item = Cell> {
@@ -383,6 +387,12 @@ pub(super) fn simplify(points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
             break;
         }
         if cyc.alive == before {
+            // cells past the curve's size defer nothing more, and a zero
+            // median (points that rounding made coincide) never coarsens
+            let reach = coarsen * *median;
+            if reach > size || !reach.is_finite() || *median == 0.0 {
+                break;
+            }
             coarsen *= 2.0;
         }
     }
