@@ -271,6 +271,47 @@ pub fn floor_bound(info: &GradientInfo, max_diagonal: f64, state: &RodState, dof
         * (max_diagonal * extent.max(1e-3) + info.force_scale)
 }
 
+/// ‖∇E‖ at a state beside its measured floor and the bound gating that
+/// measurement, for reports and tests of the convergence test.
+#[derive(Clone, Copy, Debug)]
+pub struct FloorCheck {
+    /// ‖∇E‖.
+    pub gradient: f64,
+    /// ‖∇E‖ over the scale of the internal forces (0 with no forces).
+    pub rel: f64,
+    /// The measured round-off floor ([`FloorProbe::measure`]).
+    pub floor: f64,
+    /// Its bound ([`floor_bound`]).
+    pub bound: f64,
+}
+
+impl FloorCheck {
+    /// The check at `state`, evaluated afresh.
+    pub fn at(energy: &RodEnergy, state: &RodState) -> Self {
+        let dofs = energy.map.len();
+        let (mut grad, mut values) = (vec![0.0; dofs], vec![0.0; energy.pattern.nnz()]);
+        let info = energy.hessian(state, &mut grad, &mut values);
+        let gradient = grad.iter().map(|g| g * g).sum::<f64>().sqrt();
+        let rel = if info.force_scale > 0.0 {
+            gradient / info.force_scale
+        } else {
+            0.0
+        };
+        let max_diagonal = energy.pattern.max_abs_diagonal(&values);
+        FloorCheck {
+            gradient,
+            rel,
+            floor: FloorProbe::default().measure(energy, state),
+            bound: floor_bound(&info, max_diagonal, state, dofs),
+        }
+    }
+
+    /// Whether the state passes the convergence test at `tol`.
+    pub fn passes(&self, tol: f64) -> bool {
+        self.rel <= tol || self.gradient <= self.floor
+    }
+}
+
 /// Scratch of the measured round-off floor, allocated on first use and
 /// reused by every later measurement of the same solver.
 #[derive(Clone, Debug, Default)]

@@ -4,7 +4,7 @@
 
 use crate::report::error::Result;
 use crate::scene::Scene;
-use crate::solve::outcome::{FloorProbe, floor_bound};
+use crate::solve::outcome::FloorCheck;
 use crate::study::start::starting_equilibrium;
 use std::fmt::Write;
 
@@ -60,18 +60,12 @@ fn row(name: &str, n: usize, stiffness: Option<f64>, text: &str) -> Result<Strin
             ));
         }
     };
-    let energy = &newton.energy;
-    let dofs = energy.map.len();
-    let (mut grad, mut values) = (vec![0.0; dofs], vec![0.0; energy.pattern.nnz()]);
-    let info = energy.hessian(&state, &mut grad, &mut values);
-    let gnorm = grad.iter().map(|g| g * g).sum::<f64>().sqrt();
-    let floor = FloorProbe::default().measure(energy, &state);
-    let bound = floor_bound(
-        &info,
-        energy.pattern.max_abs_diagonal(&values),
-        &state,
-        dofs,
-    );
+    let FloorCheck {
+        gradient: gnorm,
+        floor,
+        bound,
+        ..
+    } = FloorCheck::at(&newton.energy, &state);
     Ok(format!(
         "| {name} | {n} | {stiffness} | {} | {gnorm:.2e} | {:.2e} | {floor:.2e} | {:.2} | {bound:.2e} | {:.1e} |\n",
         report.iterations,
