@@ -11,7 +11,7 @@ use knotrod::io::auto::{
 use knotrod::io::verify_file::{VerifyFileError, read_solutions};
 use knotrod::model::rod::Parameter;
 use knotrod::report::auto_events::compare_with_continuation;
-use knotrod::study::verify::{InputVerdict, Verdict, VerifyOptions, verify_all};
+use knotrod::study::verify::{Verdict, VerifyOptions, verify_all};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -390,21 +390,6 @@ fn every_label_of_an_auto_07p_run_of_figure_3_is_confirmed_and_its_fold_is_knotr
     )
     .unwrap();
     for (c, label) in checks.iter().zip(&kinds_of_rows(&input)) {
-        if *label == PointType::Fold {
-            // AUTO's fold satisfies its boundary conditions on the continuum,
-            // but the discrete rod's own fold lies O(h²) above it in φ: at
-            // φ_LP it has no equilibrium, so the row is judged by the fold's
-            // location below (a fold row verified fold by fold at each N is
-            // left to the verdict logic, src/study/verify.rs)
-            assert_eq!(
-                c.input,
-                InputVerdict::Satisfies,
-                "{}: {:?}",
-                c.given.name,
-                c.input
-            );
-            continue;
-        }
         assert_eq!(
             c.verdict,
             Verdict::Confirmed,
@@ -414,6 +399,37 @@ fn every_label_of_an_auto_07p_run_of_figure_3_is_confirmed_and_its_fold_is_knotr
             c.input,
             c.rounding_units.unwrap_or(f64::NAN)
         );
+        if *label == PointType::Fold {
+            // AUTO's LP is verified as a fold: at each N the discrete rod's
+            // own fold (which lies O(h²) from AUTO's φ, where the discrete
+            // rod may have no equilibrium), extrapolated, and the continuum's
+            let fold = c.fold.as_ref().expect("an LP row is checked as a fold");
+            let (continuum, error) = fold.continuum.expect("the continuum fold located");
+            let lp = input
+                .events
+                .iter()
+                .find(|e| e.kind == PointType::Fold)
+                .unwrap();
+            let tolerance = lp.tolerance.unwrap();
+            assert!(
+                (continuum - fold.given).abs() <= error + tolerance,
+                "AUTO's LP {} against the continuum fold {continuum} ± {error:.1e} (AUTO ± {tolerance:.1e})",
+                fold.given
+            );
+            // the discrete folds converge to it at second order
+            let e = c
+                .estimates
+                .iter()
+                .find(|e| e.quantity == knotrod::study::verify::Quantity::Fold)
+                .unwrap();
+            assert!((1.5..=2.5).contains(&e.order), "{e:?}");
+            assert_eq!(e.agrees, Some(true), "{e:?}");
+            assert!(
+                c.claims
+                    .iter()
+                    .any(|k| k.claim.starts_with("fold") && k.confirmed())
+            );
+        }
     }
     // AUTO's LP against knotrod's polished fold, within the two bars
     let compared = compare_with_continuation(&input).unwrap();

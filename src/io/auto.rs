@@ -17,7 +17,7 @@
 
 use crate::model::rod::{Law, Parameter};
 use crate::scene::{Scene, SceneError};
-use crate::study::verify::{Claims, Solution};
+use crate::study::verify::{Claims, FoldClaim, Solution};
 use std::path::{Path, PathBuf};
 
 /// Most mesh points (NTPL) of one solution read.
@@ -1020,6 +1020,15 @@ pub fn read_auto_input(
         check_against_branch(&map, s, &branch)?;
     }
     let events = events_of(&map, &labelled, &branch);
+    // a labelled fold is verified as one: at each N the discrete rod's own
+    for e in &events {
+        if let (PointType::Fold, Some(k), Some(parameter)) = (e.kind, e.row, e.parameter) {
+            solutions[k].fold = Some(FoldClaim {
+                parameter,
+                tolerance: e.tolerance.unwrap_or(0.0),
+            });
+        }
+    }
     Ok(AutoInput {
         map,
         scene: base,
@@ -1086,6 +1095,7 @@ fn row_of(map: &AutoMap, s: &AutoSolution, slots: &[usize; 6]) -> Result<Solutio
         unknowns,
         rounding,
         claims: Claims::default(),
+        fold: None,
     })
 }
 

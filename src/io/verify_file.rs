@@ -565,6 +565,7 @@ fn solution(
         unknowns: values,
         rounding,
         claims,
+        fold: None,
     })
 }
 

@@ -220,7 +220,11 @@ pub fn verdict_line(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
         }
         Verdict::ClaimsRefuted => format!("CLAIMS REFUTED{}{twin}", refuted(c)),
         Verdict::Confirmed => format!(
-            "CONFIRMED by both methods ({}, knot {}{}){}{twin}{}",
+            "CONFIRMED by both methods ({}{}, knot {}{}){}{twin}{}",
+            c.fold.as_ref().map_or(String::new(), |f| format!(
+                "a fold in {}; beside its null direction: ",
+                f.parameter.name()
+            )),
             inertia(c),
             c.continuum_knot.as_deref().unwrap_or("none"),
             if c.claims.is_empty() {
@@ -333,6 +337,89 @@ pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
     if let Some(e) = &c.fit_error {
         let _ = writeln!(s, "Fit failed: {e}\n");
     }
+    s.push_str(&fold_section(c));
+    s.push_str(&discrete_tables(c));
+    s.push_str(&estimates_table(c));
+    if !c.claims.is_empty() {
+        let _ = writeln!(s, "| claim | claimed | found | outcome |");
+        let _ = writeln!(s, "|---|---|---|---|");
+        for k in &c.claims {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} |",
+                k.claim,
+                k.claimed,
+                k.found,
+                match k.outcome {
+                    ClaimOutcome::Confirmed => "confirmed",
+                    ClaimOutcome::Refuted => "REFUTED",
+                    ClaimOutcome::Undecided => "undecided",
+                }
+            );
+        }
+        let _ = writeln!(s);
+    }
+    if let Some(e) = &c.error {
+        let _ = writeln!(s, "Error: {e}\n");
+    }
+    s
+}
+
+/// A claimed fold: the discrete rod's own folds at N, 2N, 4N beside the
+/// continuum's and the claimed one.
+fn fold_section(c: &SolutionCheck) -> String {
+    let mut s = String::new();
+    let Some(f) = &c.fold else {
+        return s;
+    };
+    let name = f.parameter.name();
+    let _ = writeln!(
+        s,
+        "**Fold:** claimed at {name} = {} (± {:.1e}, the claimant's location tolerance). At \
+         each N the discrete rod is solved at its own fold: its branch, followed from an \
+         equilibrium near the given shape, turns back in {name} there (located by bisection \
+         in arclength); the eigenvalue that vanishes there is left out of its spectrum below. \
+         The continuum's fold is the root of its shooting Jacobian's bordered determinant, \
+         located from the discrete fold at 4N; its quantities below are the continuum \
+         solution's there.\n",
+        f.given, f.tolerance
+    );
+    let _ = writeln!(s, "| | {name} | vanishing ω² |");
+    let _ = writeln!(s, "|---|---|---|");
+    for (n, (v, w)) in c
+        .setting
+        .as_ref()
+        .map_or([0; 3], |st| st.segments)
+        .iter()
+        .zip(f.discrete.iter().zip(&f.null_omega2))
+    {
+        let _ = writeln!(s, "| discrete fold, N = {n} | {v:.12} | {w:.2e} |");
+    }
+    if let Some(e) = c.estimate(Quantity::Fold) {
+        let _ = writeln!(
+            s,
+            "| Richardson (2N, 4N) | {:.12} ± {:.1e} (order {:.2}) | |",
+            e.extrapolated[0],
+            e.error + e.model_error,
+            e.order
+        );
+    }
+    match (&f.continuum, &f.continuum_failure) {
+        (Some((v, e)), _) => {
+            let _ = writeln!(s, "| continuum fold | {v:.12} ± {e:.1e} | |");
+        }
+        (None, Some(why)) => {
+            let _ = writeln!(s, "| continuum fold | not located: {why} | |");
+        }
+        (None, None) => {}
+    }
+    let _ = writeln!(s, "| claimed | {:.12} | |\n", f.given);
+    s
+}
+
+/// The discrete rod at N, 2N, 4N and its extrapolated eigenvalues.
+fn discrete_tables(c: &SolutionCheck) -> String {
+    let mut s = String::new();
     if !c.der.is_empty() {
         let _ = writeln!(
             s,
@@ -386,6 +473,12 @@ pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
             inertia(c)
         );
     }
+    s
+}
+
+/// The extrapolated quantities against the continuum's.
+fn estimates_table(c: &SolutionCheck) -> String {
+    let mut s = String::new();
     if !c.estimates.is_empty() {
         let _ = writeln!(
             s,
@@ -414,28 +507,6 @@ pub fn details(c: &SolutionCheck, all: &[SolutionCheck]) -> String {
             "\nKnot of the continuum curve's ray closure: {}.\n",
             c.continuum_knot.as_deref().unwrap_or("none")
         );
-    }
-    if !c.claims.is_empty() {
-        let _ = writeln!(s, "| claim | claimed | found | outcome |");
-        let _ = writeln!(s, "|---|---|---|---|");
-        for k in &c.claims {
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {} |",
-                k.claim,
-                k.claimed,
-                k.found,
-                match k.outcome {
-                    ClaimOutcome::Confirmed => "confirmed",
-                    ClaimOutcome::Refuted => "REFUTED",
-                    ClaimOutcome::Undecided => "undecided",
-                }
-            );
-        }
-        let _ = writeln!(s);
-    }
-    if let Some(e) = &c.error {
-        let _ = writeln!(s, "Error: {e}\n");
     }
     s
 }

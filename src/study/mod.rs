@@ -6,6 +6,7 @@ pub mod asymptotics;
 pub mod boundary;
 pub mod branch;
 pub mod error;
+pub mod fold;
 pub mod loading;
 pub mod map;
 pub mod polish;

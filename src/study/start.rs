@@ -344,12 +344,37 @@ fn minimizer(scene: &Scene, segments: Option<usize>) -> (RodModel, Minimizer) {
 /// it); by minimisation if Newton does not converge from there, and for the
 /// laws with the constraint u2 = 0 (their SQP).
 pub fn equilibrium_near_start(scene: &Scene, segments: Option<usize>) -> Result<Equilibrium> {
+    let (mut newton, state, report) = state_near_start(scene, segments, true)?;
+    Ok(analyse(&mut newton, &state, &report, &scene.measure())?)
+}
+
+/// The equilibrium nearest the scene's initial shape, with the solver that
+/// found it: by Newton on ∇E = 0 for a Kirchhoff rod, then (if `minimise`
+/// allows it) by minimisation, which may slide off a saddle to another
+/// equilibrium; by the SQP for the laws with the constraint u2 = 0.
+pub fn state_near_start(
+    scene: &Scene,
+    segments: Option<usize>,
+    minimise: bool,
+) -> Result<(Minimizer, RodState, SolveReport)> {
     let (model, mut newton) = minimizer(scene, segments);
     let start = initial_state(scene, &model)?;
     check_start(scene, &newton.energy, &start)?;
     let mut state = start.clone();
     // the constrained laws (u2 = 0) converge by their SQP, not by Newton
     let free = model.law == Law::Kirchhoff && newton.contact.is_none();
+    if free && !minimise {
+        let report = newton
+            .find_equilibrium(&mut state, &scene.solver)
+            .context("Newton on the gradient")?;
+        if !report.converged {
+            fail!(
+                "Newton on the gradient did not converge (relative gradient {:.3e})",
+                report.gradient_norm
+            );
+        }
+        return Ok((newton, state, report));
+    }
     let newton_result = if free {
         newton.find_equilibrium(&mut state, &scene.solver).ok()
     } else {
@@ -364,7 +389,7 @@ pub fn equilibrium_near_start(scene: &Scene, segments: Option<usize>) -> Result<
                 .context("Newton minimisation")?
         }
     };
-    Ok(analyse(&mut newton, &state, &report, &scene.measure())?)
+    Ok((newton, state, report))
 }
 
 /// Solve a scene's single equilibrium at N segments (the scene's own N if None).

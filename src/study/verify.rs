@@ -69,6 +69,21 @@ pub struct Solution {
     pub rounding: [f64; 6],
     /// The author's claims.
     pub claims: Claims,
+    /// Claimed to lie at a fold (limit point) of its branch: at every N the
+    /// discrete rod is then solved at its own fold, which lies O(h²) from
+    /// the continuum's (at the given value it may have no equilibrium).
+    #[serde(default)]
+    pub fold: Option<FoldClaim>,
+}
+
+/// A claim that a solution lies at a fold of its branch.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+pub struct FoldClaim {
+    /// The branch's parameter, in which the branch turns back there.
+    pub parameter: Parameter,
+    /// How far the claimant's location of the fold may be off in it (AUTO's
+    /// own location tolerance; 0 where none is stated).
+    pub tolerance: f64,
 }
 
 /// How verify runs.
@@ -172,6 +187,8 @@ pub enum Quantity {
     Link,
     /// Lowest ω².
     LowestOmega2,
+    /// The parameter's value at a fold.
+    Fold,
 }
 
 impl Quantity {
@@ -184,6 +201,7 @@ impl Quantity {
             Quantity::Energy => "energy",
             Quantity::Link => "link",
             Quantity::LowestOmega2 => "lowest ω²",
+            Quantity::Fold => "fold's parameter",
         }
     }
 }
@@ -430,6 +448,28 @@ pub enum Verdict {
     Confirmed,
 }
 
+/// A claimed fold, checked: the discrete rod's own folds at N, 2N, 4N and
+/// the continuum's, located from the finest.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct FoldCheck {
+    /// The branch's parameter.
+    pub parameter: Parameter,
+    /// The given value (where the fold is claimed).
+    pub given: f64,
+    /// The claimant's location tolerance.
+    pub tolerance: f64,
+    /// The discrete rod's fold at N, 2N, 4N.
+    pub discrete: [f64; 3],
+    /// The eigenvalue that vanishes there (the fold's null direction, left
+    /// out of the stability: its sign is the location's round-off).
+    pub null_omega2: [f64; 3],
+    /// The continuum's fold (the root of its shooting Jacobian's bordered
+    /// determinant, from the discrete fold at 4N) and its error.
+    pub continuum: Option<(f64, f64)>,
+    /// Why the continuum's fold could not be located.
+    pub continuum_failure: Option<String>,
+}
+
 /// Everything verify found about one solution.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct SolutionCheck {
@@ -466,6 +506,9 @@ pub struct SolutionCheck {
     /// points (None where the continuum's stability is not covered).
     #[serde(default)]
     pub continuum_negative: Option<usize>,
+    /// At a claimed fold: the discrete rod's folds and the continuum's.
+    #[serde(default)]
+    pub fold: Option<FoldCheck>,
     /// The discrete rod at N, 2N, 4N.
     pub der: Vec<DerRow>,
     /// The extrapolated quantities against the continuum.
@@ -504,6 +547,7 @@ impl SolutionCheck {
             fit_error: None,
             continuum_knot: None,
             continuum_negative: None,
+            fold: None,
             der: vec![],
             estimates: vec![],
             stability: None,
@@ -681,11 +725,100 @@ fn run(
         return Ok(());
     }
     let claimed_knot = s.claims.knot.as_deref().map(knot_claim).transpose()?;
-    // the continuum curve's own topology and link
-    let curve = continuum.solve(&polished.unknowns, CURVE_SAMPLES)?;
+    let found = match s.fold {
+        None => at_parameters(&scene, &continuum, &polished.unknowns, options)?,
+        Some(claim) => at_fold(&scene, &polished.unknowns, claim, options)?,
+    };
+    check.continuum_knot = found.continuum_knot;
+    check.continuum_negative = found.continuum_negative;
+    let (eqs, soft) = (&found.eqs, &found.soft);
+    check.der = options
+        .segments
+        .iter()
+        .zip(eqs)
+        .map(|(&n, e)| der_row(n, e))
+        .collect();
+    check.stability = found.stability;
+    let values = |q: Quantity, e: &Equilibrium| -> Option<Vec<f64>> {
+        Some(match q {
+            Quantity::Force => e.n0.to_vec(),
+            Quantity::Moment => e.m0.to_vec(),
+            Quantity::Twist => vec![e.twist],
+            Quantity::Energy => vec![e.energy],
+            Quantity::Link => vec![e.link],
+            Quantity::LowestOmega2 => vec![*e.omega_squared.first()?],
+            Quantity::Fold => return None,
+        })
+    };
+    for q in [
+        Quantity::Force,
+        Quantity::Moment,
+        Quantity::Twist,
+        Quantity::Energy,
+        Quantity::Link,
+        Quantity::LowestOmega2,
+    ] {
+        let Some(v) = eqs.iter().map(|e| values(q, e)).collect::<Option<Vec<_>>>() else {
+            continue;
+        };
+        let c = found
+            .continuum
+            .iter()
+            .find(|(k, _)| *k == q)
+            .map(|(_, v)| v.clone());
+        let model = values(q, soft).map_or(0.0, |w| distance(&w, &v[0]) / 9.0);
+        check.estimates.push(estimate(
+            q,
+            [v[0].clone(), v[1].clone(), v[2].clone()],
+            model,
+            c,
+        ));
+    }
+    if let Some((fold, soft_value)) = found.fold {
+        check.estimates.push(estimate(
+            Quantity::Fold,
+            fold.discrete.map(|v| vec![v]),
+            (soft_value - fold.discrete[0]).abs() / 9.0,
+            fold.continuum.map(|(v, e)| (vec![v], e)),
+        ));
+        check.fold = Some(fold);
+    }
+    check.disagreements = disagreements(check);
+    check.claims = claims_checked(&s.claims, claimed_knot.as_deref(), check);
+    Ok(())
+}
+
+/// What the two methods found of one row, before they are compared.
+struct Found {
+    /// The discrete rod at N, 2N, 4N.
+    eqs: Vec<Equilibrium>,
+    /// At N with a tenth of the stretching stiffness.
+    soft: Equilibrium,
+    /// Stability from the extrapolated eigenvalues.
+    stability: Option<Stability>,
+    /// The continuum's quantities, each with its error.
+    continuum: Vec<(Quantity, (Vec<f64>, f64))>,
+    /// The continuum curve's knot type.
+    continuum_knot: Option<String>,
+    /// The continuum's negative directions (conjugate points).
+    continuum_negative: Option<usize>,
+    /// At a fold: the folds, and the softer rod's fold value.
+    fold: Option<(FoldCheck, f64)>,
+}
+
+/// The continuum solution `p` at the scene's parameters: its knot type and
+/// its quantities, each with its error (`relative` of its size, the link
+/// with its writhe's sampling error).
+fn continuum_values(
+    scene: &Scene,
+    continuum: &Continuum,
+    p: &Unknowns,
+    relative: f64,
+) -> Result<(Option<String>, Vec<(Quantity, (Vec<f64>, f64))>)> {
+    let curve = continuum.solve(p, CURVE_SAMPLES)?;
     let clamps = scene.clamps();
     let [down, up] = clamps.ray_directions();
-    check.continuum_knot = closure_knot_along(&curve.centreline, [down, up])
+    let knot = closure_knot_along(&curve.centreline, [down, up])
         .ok()
         .and_then(|k| k.name);
     // the polygon's writhe converges as h²: two samplings give its value
@@ -697,8 +830,8 @@ fn run(
     let half: Vec<_> = curve.centreline.iter().step_by(2).copied().collect();
     let coarse = writhe(&half);
     let writhe = fine + (fine - coarse) / 3.0;
-    let tiny = |v: f64| 1e-10 * v.abs().max(1.0);
-    let mut continuum_values = vec![
+    let tiny = |v: f64| relative * v.abs().max(1.0);
+    let values = vec![
         (
             Quantity::Force,
             (curve.n0.as_slice().to_vec(), tiny(curve.n0.norm())),
@@ -714,74 +847,214 @@ fn run(
             (vec![curve.twist + writhe], (fine - coarse).abs() / 3.0),
         ),
     ];
-    // the discrete rod from the polished shape at N, 2N, 4N
+    Ok((knot, values))
+}
+
+/// The discrete rod from the polished shape `p` at the given parameters,
+/// and the continuum solution there.
+fn at_parameters(
+    scene: &Scene,
+    continuum: &Continuum,
+    p: &Unknowns,
+    options: &VerifyOptions,
+) -> Result<Found> {
+    let (continuum_knot, mut values) = continuum_values(scene, continuum, p, 1e-10)?;
     let mut der_scene = scene.clone();
-    set_unknowns(&mut der_scene, &polished.unknowns.into());
+    set_unknowns(&mut der_scene, &(*p).into());
     // as many eigenvalues as it takes to see a positive one
     let (eqs, soft, stability) = loop {
         let (eqs, soft) = discrete_rods(&der_scene, options)?;
         let stability = stability_of(&eqs, &soft);
-        let computed = der_scene.stability.eigenvalues as usize;
-        if stability.as_ref().is_none_or(|s| s.complete) || computed >= MAX_EIGENVALUES {
+        if enough_eigenvalues(&stability, &der_scene) {
             break (eqs, soft, stability);
         }
-        der_scene.stability.eigenvalues = (2 * computed).min(MAX_EIGENVALUES) as i64;
+        more_eigenvalues(&mut der_scene);
     };
-    check.der = options
-        .segments
-        .iter()
-        .zip(&eqs)
-        .map(|(&n, e)| der_row(n, e))
-        .collect();
-    check.stability = stability;
     // stability on the continuum, by the shooting determinant of (A.4) and
     // its conjugate points: the second method for ω² and the inertia (only
     // where both ends are clamped; elsewhere the discrete rod's alone)
+    let mut continuum_negative = None;
     if let Some(lowest) = eqs.last().and_then(|e| e.omega_squared.first())
-        && let Ok(spectrum) = continuum.lowest_frequencies(&polished.unknowns, 1, lowest.abs())
+        && let Ok(spectrum) = continuum.lowest_frequencies(p, 1, lowest.abs())
     {
-        continuum_values.push((
+        values.push((
             Quantity::LowestOmega2,
             (spectrum.values.clone(), spectrum.errors[0]),
         ));
-        check.continuum_negative = Some(spectrum.negative);
+        continuum_negative = Some(spectrum.negative);
     }
-    let values = |q: Quantity, e: &Equilibrium| -> Option<Vec<f64>> {
-        Some(match q {
-            Quantity::Force => e.n0.to_vec(),
-            Quantity::Moment => e.m0.to_vec(),
-            Quantity::Twist => vec![e.twist],
-            Quantity::Energy => vec![e.energy],
-            Quantity::Link => vec![e.link],
-            Quantity::LowestOmega2 => vec![*e.omega_squared.first()?],
-        })
+    Ok(Found {
+        eqs,
+        soft,
+        stability,
+        continuum: values,
+        continuum_knot,
+        continuum_negative,
+        fold: None,
+    })
+}
+
+fn enough_eigenvalues(stability: &Option<Stability>, scene: &Scene) -> bool {
+    stability.as_ref().is_none_or(|s| s.complete)
+        || scene.stability.eigenvalues as usize >= MAX_EIGENVALUES
+}
+
+fn more_eigenvalues(scene: &mut Scene) {
+    let computed = scene.stability.eigenvalues as usize;
+    scene.stability.eigenvalues = (2 * computed).min(MAX_EIGENVALUES) as i64;
+}
+
+/// The locating resolution of a continuum fold in its held unknown
+/// (relative; `study::polish`'s): the error of the state located there.
+const FOLD_RESOLUTION: f64 = 1e-7;
+
+/// The discrete rod at its own fold at N, 2N, 4N (and at N with a tenth of
+/// the stiffness), from the polished shape `p`; the continuum's fold located
+/// from the finest; the continuum solution and spectrum there.
+fn at_fold(
+    scene: &Scene,
+    p: &Unknowns,
+    claim: FoldClaim,
+    options: &VerifyOptions,
+) -> Result<Found> {
+    let parameter = claim.parameter;
+    let mut der_scene = scene.clone();
+    set_unknowns(&mut der_scene, &(*p).into());
+    let (folds, soft, stability) = loop {
+        let (folds, soft) = discrete_folds(&der_scene, options, parameter)?;
+        let eqs: Vec<Equilibrium> = folds.iter().map(|f| f.equilibrium.clone()).collect();
+        let stability = stability_of(&eqs, &soft.equilibrium);
+        if enough_eigenvalues(&stability, &der_scene) {
+            break (folds, soft, stability);
+        }
+        more_eigenvalues(&mut der_scene);
     };
-    for q in [
-        Quantity::Force,
-        Quantity::Moment,
-        Quantity::Twist,
-        Quantity::Energy,
-        Quantity::Link,
-        Quantity::LowestOmega2,
-    ] {
-        let Some(v) = eqs.iter().map(|e| values(q, e)).collect::<Option<Vec<_>>>() else {
-            continue;
-        };
-        let c = continuum_values
-            .iter()
-            .find(|(k, _)| *k == q)
-            .map(|(_, v)| v.clone());
-        let model = values(q, &soft).map_or(0.0, |w| distance(&w, &v[0]) / 9.0);
-        check.estimates.push(estimate(
-            q,
-            [v[0].clone(), v[1].clone(), v[2].clone()],
-            model,
-            c,
-        ));
+    let finest = &folds[2];
+    let n4 = options.segments[2];
+    let model = der_scene.rod_model(Some(n4));
+    let mut event = [crate::analysis::event::Event::at(
+        crate::analysis::event::EventKind::Fold,
+        &finest.state.clamps,
+        finest.state.twist(),
+        0,
+        String::new(),
+    )];
+    crate::study::polish::polish_events(
+        &model,
+        parameter,
+        &scene.measure(),
+        &mut event,
+        std::slice::from_ref(&finest.state),
+    );
+    let [event] = event;
+    let mut fold = FoldCheck {
+        parameter,
+        given: parameter.value(&scene.clamps()),
+        tolerance: claim.tolerance,
+        discrete: [folds[0].value, folds[1].value, folds[2].value],
+        null_omega2: [
+            folds[0].null_omega2,
+            folds[1].null_omega2,
+            folds[2].null_omega2,
+        ],
+        continuum: None,
+        continuum_failure: None,
+    };
+    let (mut continuum_knot, mut values, mut continuum_negative) = (None, vec![], None);
+    match event.continuum {
+        Some(c) => {
+            fold.continuum = Some((c.value, c.error));
+            let mut at = scene.clone();
+            at.set(parameter, c.value);
+            let continuum = continuum_of(&at, options)?;
+            let u = Unknowns::from(c.unknowns);
+            (continuum_knot, values) = continuum_values(&at, &continuum, &u, FOLD_RESOLUTION)?;
+            // the continuum's spectrum there, its null direction left out as
+            // the discrete rod's is
+            let lowest = finest.equilibrium.omega_squared.first().copied();
+            if let Some(lowest) = lowest
+                && let Ok(spectrum) = continuum.lowest_frequencies(&u, 2, lowest.abs())
+            {
+                let null = if spectrum.values[0].abs() <= spectrum.values[1].abs() {
+                    0
+                } else {
+                    1
+                };
+                let other = 1 - null;
+                values.push((
+                    Quantity::LowestOmega2,
+                    (vec![spectrum.values[other]], spectrum.errors[other]),
+                ));
+                let below = usize::from(spectrum.values[null] < 0.0);
+                continuum_negative = spectrum.negative.checked_sub(below);
+            }
+        }
+        None => fold.continuum_failure = Some(event.detail.trim_start_matches("; ").into()),
     }
-    check.disagreements = disagreements(check);
-    check.claims = claims_checked(&s.claims, claimed_knot.as_deref(), check);
-    Ok(())
+    let eqs = folds.into_iter().map(|f| f.equilibrium).collect();
+    Ok(Found {
+        eqs,
+        soft: soft.equilibrium,
+        stability,
+        continuum: values,
+        continuum_knot,
+        continuum_negative,
+        fold: Some((fold, soft.value)),
+    })
+}
+
+/// A discrete fold with its vanishing eigenvalue taken out of its spectrum.
+struct Folded {
+    value: f64,
+    state: crate::model::rod::RodState,
+    equilibrium: Equilibrium,
+    null_omega2: f64,
+}
+
+fn folded(f: crate::study::fold::DiscreteFold) -> Folded {
+    let mut equilibrium = f.equilibrium;
+    let omega = &mut equilibrium.omega_squared;
+    let null = (0..omega.len())
+        .min_by(|&a, &b| omega[a].abs().total_cmp(&omega[b].abs()))
+        .map_or(f64::NAN, |k| omega.remove(k));
+    // the inertia counts the null direction on the side its round-off puts
+    // it (its Lanczos value and the LDLᵀ pivots may differ there): the
+    // count beside it is that of the other negative eigenvalues, when the
+    // computed ones reach a positive one
+    let below = omega.iter().filter(|w| **w < 0.0).count();
+    let complete = omega.iter().any(|w| *w > 0.0);
+    let inertia = &mut equilibrium.negative_eigenvalues;
+    if complete && *inertia > below {
+        *inertia = below.max(inertia.saturating_sub(1));
+    } else if !complete && null < 0.0 {
+        *inertia = inertia.saturating_sub(1);
+    }
+    Folded {
+        value: f.value,
+        state: f.state,
+        equilibrium,
+        null_omega2: null,
+    }
+}
+
+/// The discrete rod at its own fold in `parameter` at N, 2N, 4N, and at N
+/// with a tenth of the stretching stiffness.
+fn discrete_folds(
+    scene: &Scene,
+    options: &VerifyOptions,
+    parameter: Parameter,
+) -> Result<(Vec<Folded>, Folded)> {
+    let mut folds = Vec::new();
+    for n in options.segments {
+        let f = crate::study::fold::fold_near(scene, Some(n), parameter)
+            .with_context(|| format!("the discrete rod's fold at N = {n}"))?;
+        folds.push(folded(f));
+    }
+    let mut softer = scene.clone();
+    softer.model.stretching_stiffness = Some(options.stretching_stiffness / 10.0);
+    let soft = crate::study::fold::fold_near(&softer, Some(options.segments[0]), parameter)
+        .context("the discrete rod's fold at N with a tenth of the stretching stiffness")?;
+    Ok((folds, folded(soft)))
 }
 
 /// The discrete rod at N, 2N, 4N, and at N with a tenth of the stretching
@@ -1105,6 +1378,26 @@ fn claims_checked(
             outcome: decided(v == d.walled),
         });
     }
+    if let (Some(fold), Some(e)) = (&check.fold, check.estimate(Quantity::Fold)) {
+        // where the continuum's fold could not be located, the discrete
+        // rod's extrapolated one stands for it
+        let found = e.continuum.as_ref().unwrap_or(&e.extrapolated)[0];
+        let rounding = check
+            .given
+            .parameters
+            .iter()
+            .position(|(q, _)| *q == fold.parameter)
+            .and_then(|k| check.given.parameter_rounding.get(k).copied())
+            .unwrap_or(0.0);
+        let errors = e.error + e.model_error + e.continuum_error.unwrap_or(0.0);
+        let off = (found - fold.given).abs();
+        out.push(ClaimCheck {
+            claim: format!("fold in {}", fold.parameter.name()),
+            claimed: format!("{} ± {:.1e}", fold.given, fold.tolerance),
+            found: format!("{found:.12} ± {errors:.1e} ({off:.1e} off)"),
+            outcome: decided(off <= 2.0 * rounding + fold.tolerance + BAR * errors),
+        });
+    }
     if let (Some(given), Some(v)) = (&claims.knot, claimed_knot) {
         let found = finest.and_then(|d| d.knot.clone());
         // the table names every knot of a polynomial, joined by " or "
@@ -1426,6 +1719,7 @@ mod tests {
             unknowns: [0.0; 6],
             rounding: [1e-9; 6],
             claims: Claims::default(),
+            fold: None,
         }
     }
 }
