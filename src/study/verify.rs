@@ -788,6 +788,9 @@ fn run(
     Ok(())
 }
 
+/// A quantity of the continuum solution: its value and error.
+type ContinuumValue = (Quantity, (Vec<f64>, f64));
+
 /// What the two methods found of one row, before they are compared.
 struct Found {
     /// The discrete rod at N, 2N, 4N.
@@ -797,7 +800,7 @@ struct Found {
     /// Stability from the extrapolated eigenvalues.
     stability: Option<Stability>,
     /// The continuum's quantities, each with its error.
-    continuum: Vec<(Quantity, (Vec<f64>, f64))>,
+    continuum: Vec<ContinuumValue>,
     /// The continuum curve's knot type.
     continuum_knot: Option<String>,
     /// The continuum's negative directions (conjugate points).
@@ -814,7 +817,7 @@ fn continuum_values(
     continuum: &Continuum,
     p: &Unknowns,
     relative: f64,
-) -> Result<(Option<String>, Vec<(Quantity, (Vec<f64>, f64))>)> {
+) -> Result<(Option<String>, Vec<ContinuumValue>)> {
     let curve = continuum.solve(p, CURVE_SAMPLES)?;
     let clamps = scene.clamps();
     let [down, up] = clamps.ray_directions();
