@@ -66,6 +66,19 @@ impl SolveReport {
         }
     }
 
+    /// The report of a point the continuation's corrector converged to, in
+    /// `iterations` with relative gradient `rel`.
+    pub fn of_corrector(iterations: usize, rel: f64, energy: f64) -> Self {
+        SolveReport {
+            converged: true,
+            iterations,
+            residual_history: vec![rel],
+            gradient_norm: rel,
+            energy,
+            ..SolveReport::start()
+        }
+    }
+
     pub(crate) fn record(&mut self, iteration: usize, rel: f64, energy: f64) {
         self.residual_history.push(rel);
         self.gradient_norm = rel;

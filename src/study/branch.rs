@@ -131,16 +131,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
 
     fn measure(&mut self, p: &Point, branch: usize, leg: usize) -> Result<Equilibrium> {
         let energy = self.tracer.newton.energy.energy(&p.state);
-        let report = SolveReport {
-            converged: true,
-            iterations: p.iterations,
-            residual_history: vec![p.residual],
-            gradient_norm: p.residual,
-            energy,
-            factorizations: 0,
-            contacts: Vec::new(),
-            contact_rows: Vec::new(),
-        };
+        let report = SolveReport::of_corrector(p.iterations, p.residual, energy);
         let mut eq = analyse_from(
             self.tracer.newton,
             &p.state,

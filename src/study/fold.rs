@@ -99,9 +99,9 @@ pub fn fold_near(
         stop_at: vec![EventKind::Fold],
     };
     let settings_tolerance = options.settings.tolerance;
-    let mut reached: Vec<f64> = Vec::new();
-    let mut ignore = |e: Equilibrium| {
-        reached.push(e.phi_over_2pi);
+    let mut reached = 0usize;
+    let mut ignore = |_: Equilibrium| {
+        reached += 1;
         Ok(())
     };
     let mut run = BranchRun::new(&mut newton, options, &mut ignore, 0);
@@ -124,17 +124,11 @@ pub fn fold_near(
         .collect();
     drop(run);
     let Some(at) = nearest else {
-        let (lo, hi) = reached
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(*v), b.max(*v))
-            });
         fail!(
-            "the discrete branch has no fold in {} within {} ± {:.0e}: {} points, φ/2π from {lo} to {hi}, events [{}]",
+            "the discrete branch has no fold in {} within {} ± {:.0e} ({reached} points followed; events [{}])",
             parameter.name(),
             given,
             WINDOW * scale,
-            reached.len(),
             kinds.join(", ")
         );
     };
@@ -148,17 +142,7 @@ pub fn fold_near(
             check.rel
         );
     }
-    let gradient = check.rel;
-    let report = SolveReport {
-        converged: true,
-        iterations: 0,
-        residual_history: vec![gradient],
-        gradient_norm: gradient,
-        energy: newton.energy.energy(&at),
-        factorizations: 0,
-        contacts: Vec::new(),
-        contact_rows: Vec::new(),
-    };
+    let report = SolveReport::of_corrector(0, check.rel, newton.energy.energy(&at));
     let equilibrium = analyse(&mut newton, &at, &report, &measure)?;
     Ok(DiscreteFold {
         parameter,

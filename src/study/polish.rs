@@ -19,6 +19,10 @@ use rayon::prelude::*;
 /// a second pass at a hundredth of it).
 pub const POLISH_TOLERANCE: f64 = 1e-10;
 
+/// The resolution (relative) to which a fold is located in the unknown held
+/// there: the located state's error along the branch.
+pub const FOLD_RESOLUTION: f64 = 1e-7;
+
 /// What kind of root an event is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Class {
@@ -235,7 +239,7 @@ pub(crate) fn locate_root(
     let resolution = if held == PARAMETER {
         branch.tolerance
     } else {
-        1e-7
+        FOLD_RESOLUTION
     } * scale;
     let coarse = branch
         .locate(z, held, 1e-4 * scale, resolution, test)

@@ -363,25 +363,14 @@ pub fn state_near_start(
     let mut state = start.clone();
     // the constrained laws (u2 = 0) converge by their SQP, not by Newton
     let free = model.law == Law::Kirchhoff && newton.contact.is_none();
-    if free && !minimise {
-        let report = newton
-            .find_equilibrium(&mut state, &scene.solver)
-            .context("Newton on the gradient")?;
-        if !report.converged {
-            fail!(
-                "Newton on the gradient did not converge (relative gradient {:.3e})",
-                report.gradient_norm
-            );
-        }
-        return Ok((newton, state, report));
-    }
-    let newton_result = if free {
-        newton.find_equilibrium(&mut state, &scene.solver).ok()
-    } else {
-        None
-    };
+    let newton_result = free.then(|| newton.find_equilibrium(&mut state, &scene.solver));
     let report = match newton_result {
-        Some(r) if r.converged => r,
+        Some(Ok(r)) if r.converged => r,
+        Some(Err(e)) if !minimise => return Err(e).context("Newton on the gradient"),
+        Some(Ok(r)) if !minimise => fail!(
+            "Newton on the gradient did not converge (relative gradient {:.3e})",
+            r.gradient_norm
+        ),
         _ => {
             state = start;
             newton

@@ -21,6 +21,7 @@ use crate::model::continuum::{Continuum, Polished, Unknowns};
 use crate::model::rod::{Law, Parameter};
 use crate::scene::{InitialShape, Scene};
 use crate::study::error::{Context, Result, StudyError, describe, fail};
+use crate::study::polish::FOLD_RESOLUTION;
 use crate::study::start::equilibrium_near_start;
 use serde::{Deserialize, Serialize};
 
@@ -906,10 +907,6 @@ fn more_eigenvalues(scene: &mut Scene) {
     let computed = scene.stability.eigenvalues as usize;
     scene.stability.eigenvalues = (2 * computed).min(MAX_EIGENVALUES) as i64;
 }
-
-/// The locating resolution of a continuum fold in its held unknown
-/// (relative; `study::polish`'s): the error of the state located there.
-const FOLD_RESOLUTION: f64 = 1e-7;
 
 /// The discrete rod at its own fold at N, 2N, 4N (and at N with a tenth of
 /// the stiffness), from the polished shape `p`; the continuum's fold located
