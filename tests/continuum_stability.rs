@@ -2,7 +2,7 @@
 //! from the shooting determinant, counted by conjugate points, against the
 //! discrete rod's Richardson values.
 
-use knotrod::model::continuum::Continuum;
+use knotrod::solve::continuum::Continuum;
 use knotrod::scene::Scene;
 use nalgebra::Vector6;
 

@@ -5,7 +5,8 @@
 //! finite differences are in energy_derivatives.rs.
 
 use knotrod::model::rod::{EndKind, Ends};
-use knotrod::model::shooting::{ShootingSolution, refine_shooting_loaded};
+use knotrod::model::shooting::ShootingSolution;
+use knotrod::solve::continuum::shooting::refine_shooting_loaded;
 use knotrod::report::analytic::{
     cantilever_tip_deflection, free_semicircle, heavy_column_constant, heavy_column_weight,
 };

@@ -3,7 +3,7 @@
 
 use knotrod::io::summary::relative_deviation;
 use knotrod::model::rod::Clamps;
-use knotrod::model::shooting::refine_shooting;
+use knotrod::solve::continuum::shooting::refine_shooting;
 use knotrod::scene::Scene;
 use knotrod::study::start::solve_scene;
 use nalgebra::Vector3;

@@ -17,7 +17,7 @@
 use crate::analysis::equilibrium::Equilibrium;
 use crate::geometry::closure::{closure_knot_along, ray_closure};
 use crate::geometry::writhe::writhe_closed;
-use crate::model::continuum::{Continuum, Polished, Unknowns};
+use crate::solve::continuum::{Continuum, Polished, Unknowns};
 use crate::model::rod::{Law, Parameter};
 use crate::scene::{InitialShape, Scene};
 use crate::study::error::{Context, Result, StudyError, describe, fail};

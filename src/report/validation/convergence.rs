@@ -4,7 +4,8 @@
 use super::format::{error_cells, norm3};
 use crate::analysis::equilibrium::Equilibrium;
 use crate::model::rod::RodModel;
-use crate::model::shooting::{ShootingSolution, refine_shooting};
+use crate::model::shooting::ShootingSolution;
+use crate::solve::continuum::shooting::refine_shooting;
 use crate::report::error::{Context, Result};
 use crate::scene::{InitialShape, Scene};
 use crate::study::start::solve_scene;

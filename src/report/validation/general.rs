@@ -5,7 +5,7 @@
 
 use super::format::order;
 use crate::model::rod::{Parameter, RodState};
-use crate::model::shooting::refine_shooting_loaded;
+use crate::solve::continuum::shooting::refine_shooting_loaded;
 use crate::report::analytic::greenhill_constant;
 use crate::report::error::{ReportError, Result};
 use crate::scene::Scene;

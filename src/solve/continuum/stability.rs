@@ -10,7 +10,7 @@
 //! det B(s) — in (0, 1). The count brackets each eigenvalue, regula falsi on
 //! D refines it, and the same at a 100 times looser tolerance is its error.
 
-use crate::model::continuum::{
+use crate::solve::continuum::{
     Continuum, ContinuumError, ContinuumLaw, Unknowns, VARIATIONAL, integrate_stops,
 };
 use crate::model::rod::EndKind;

@@ -12,7 +12,7 @@
 //! the height touches a wall, crossings where the signed distance of two
 //! strands vanishes.
 
-use crate::model::continuum::{Continuum, ContinuumError, Frame, Unknowns};
+use crate::solve::continuum::{Continuum, ContinuumError, Frame, Unknowns};
 use crate::model::rod::{Clamps, Parameter, RodModel};
 use nalgebra::{Matrix6, SMatrix, SVector, Vector3, Vector6};
 
