@@ -6,11 +6,11 @@
 
 use knotrod::model::rod::{EndKind, Ends};
 use knotrod::model::shooting::ShootingSolution;
-use knotrod::solve::continuum::shooting::refine_shooting_loaded;
 use knotrod::report::analytic::{
     cantilever_tip_deflection, free_semicircle, heavy_column_constant, heavy_column_weight,
 };
 use knotrod::scene::Scene;
+use knotrod::solve::continuum::shooting::refine_shooting_loaded;
 use knotrod::study::start::solve_scene;
 use nalgebra::Vector3;
 

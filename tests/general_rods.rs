@@ -3,8 +3,8 @@
 //! and a naturally curved ring at rest.
 
 use knotrod::model::shooting::ShootingSolution;
-use knotrod::solve::continuum::shooting::refine_shooting_loaded;
 use knotrod::scene::Scene;
+use knotrod::solve::continuum::shooting::refine_shooting_loaded;
 use knotrod::study::start::solve_scene;
 use nalgebra::Vector3;
 

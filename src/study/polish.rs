@@ -8,11 +8,11 @@
 
 use crate::analysis::equilibrium::{Measure, self_approach};
 use crate::analysis::event::{ContinuumEvent, Event, EventKind};
+use crate::model::rod::{Parameter, RodModel, RodState};
 use crate::solve::continuum::Unknowns;
 use crate::solve::continuum::branch::{
     BranchPoint, ContinuumBranch, Located, PARAMETER, TestFunction, singular_borders,
 };
-use crate::model::rod::{Parameter, RodModel, RodState};
 use rayon::prelude::*;
 
 /// Tolerance of the integrator for the polish (its error estimate comes from

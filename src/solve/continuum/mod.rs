@@ -22,10 +22,10 @@ pub mod stability;
 
 use crate::model::energy::strip_energy;
 use crate::model::natural::NaturalStrains;
-use crate::solve::continuum::newton::{NewtonShootingFailure, central_jacobian, newton_shooting};
 use crate::model::rod::{Clamps, EndKind, Law, RodModel};
 use crate::model::shooting::{OdeState, end_mismatch, rhs_loaded, start_frame};
 use crate::model::strip_shooting::{StripOdeState, sadowsky, strip_rhs};
+use crate::solve::continuum::newton::{NewtonShootingFailure, central_jacobian, newton_shooting};
 use nalgebra::{Matrix6, SVector, Vector3, Vector6};
 use ode_solvers::{Dop853, OutputType, System};
 use std::f64::consts::PI;
