@@ -2,8 +2,8 @@
 //! from the shooting determinant, counted by conjugate points, against the
 //! discrete rod's Richardson values.
 
-use knotrod::model::continuum::Continuum;
 use knotrod::scene::Scene;
+use knotrod::solve::continuum::Continuum;
 use nalgebra::Vector6;
 
 /// The continuum problem of `scene` at its clamps, polished from its

@@ -5,11 +5,12 @@
 //! finite differences are in energy_derivatives.rs.
 
 use knotrod::model::rod::{EndKind, Ends};
-use knotrod::model::shooting::{ShootingSolution, refine_shooting_loaded};
+use knotrod::model::shooting::ShootingSolution;
 use knotrod::report::analytic::{
     cantilever_tip_deflection, free_semicircle, heavy_column_constant, heavy_column_weight,
 };
 use knotrod::scene::Scene;
+use knotrod::solve::continuum::shooting::refine_shooting_loaded;
 use knotrod::study::start::solve_scene;
 use nalgebra::Vector3;
 

@@ -2,8 +2,9 @@
 //! continuum solution of the same problem by shooting, with its order in N,
 //! and a naturally curved ring at rest.
 
-use knotrod::model::shooting::{ShootingSolution, refine_shooting_loaded};
+use knotrod::model::shooting::ShootingSolution;
 use knotrod::scene::Scene;
+use knotrod::solve::continuum::shooting::refine_shooting_loaded;
 use knotrod::study::start::solve_scene;
 use nalgebra::Vector3;
 

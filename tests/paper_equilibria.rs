@@ -3,8 +3,8 @@
 
 use knotrod::io::summary::relative_deviation;
 use knotrod::model::rod::Clamps;
-use knotrod::model::shooting::refine_shooting;
 use knotrod::scene::Scene;
+use knotrod::solve::continuum::shooting::refine_shooting;
 use knotrod::study::start::solve_scene;
 use nalgebra::Vector3;
 use std::path::Path;

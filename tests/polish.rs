@@ -5,12 +5,12 @@
 //! the discrete rod's error against it converging in N.
 
 use knotrod::analysis::event::{Event, EventKind};
-use knotrod::model::continuum::Unknowns;
-use knotrod::model::continuum_branch::{BranchPoint, ContinuumBranch, PARAMETER};
 use knotrod::model::natural::NaturalStrains;
-use knotrod::model::ode::central_jacobian;
 use knotrod::model::shooting::ShootingSolution;
 use knotrod::scene::Scene;
+use knotrod::solve::continuum::Unknowns;
+use knotrod::solve::continuum::branch::{BranchPoint, ContinuumBranch, PARAMETER};
+use knotrod::solve::continuum::newton::central_jacobian;
 use knotrod::study::run::run_scene;
 use nalgebra::Vector3;
 use std::path::Path;

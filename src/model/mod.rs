@@ -4,9 +4,6 @@
 
 pub mod contact;
 pub mod contact_hessian;
-pub mod continuum;
-pub mod continuum_branch;
-pub mod continuum_stability;
 pub mod energy;
 pub mod frames;
 pub mod hessian_form;

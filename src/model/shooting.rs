@@ -3,7 +3,7 @@
 //! an independent reference (the paper's own method) in validation.
 
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::{central_jacobian, hermite, rk4};
+use crate::model::ode::{hermite, rk4};
 use crate::model::rod::{Clamps, EndKind, wrap};
 use nalgebra::{SVector, Vector3, Vector6};
 use std::f64::consts::PI;
@@ -194,62 +194,6 @@ pub fn end_mismatch([r, mut d1, mut d3]: [Vector3<f64>; 3], clamps: &Clamps) -> 
         d3[1],
         wrap(d1[1].atan2(d1[0]) - clamps.phi),
     )
-}
-
-/// Refine published shooting data (n(0), m(0)) by Newton's method on the six
-/// boundary conditions at s = 1 (Jacobian by central differences: this is the
-/// paper's own method, used only to make a reference, never in the rod solver).
-pub fn refine_shooting(
-    n0: Vector3<f64>,
-    m0: Vector3<f64>,
-    k2: f64,
-    k3: f64,
-    clamps: &Clamps,
-    steps: usize,
-) -> Option<(Vector3<f64>, Vector3<f64>)> {
-    refine_shooting_loaded(
-        n0,
-        m0,
-        k2,
-        k3,
-        (Vector3::zeros(), &NaturalStrains::default()),
-        clamps,
-        steps,
-    )
-}
-
-/// As `refine_shooting`, under a body force and with natural strains
-/// (`(weight, natural)`).
-pub fn refine_shooting_loaded(
-    n0: Vector3<f64>,
-    m0: Vector3<f64>,
-    k2: f64,
-    k3: f64,
-    (weight, natural): (Vector3<f64>, &NaturalStrains),
-    clamps: &Clamps,
-    steps: usize,
-) -> Option<(Vector3<f64>, Vector3<f64>)> {
-    let mut p = Vector6::new(n0[0], n0[1], n0[2], m0[0], m0[1], m0[2]);
-    let res = |p: &Vector6<f64>| {
-        ShootingSolution::integrate_from(
-            clamps,
-            p.fixed_rows::<3>(0).into(),
-            p.fixed_rows::<3>(3).into(),
-            [k2, k3],
-            (weight, natural.clone()),
-            steps,
-        )
-        .boundary_residual(clamps)
-    };
-    for _ in 0..30 {
-        let r = res(&p);
-        if r.norm() < 1e-11 {
-            return Some((p.fixed_rows::<3>(0).into(), p.fixed_rows::<3>(3).into()));
-        }
-        let dp = central_jacobian(&p, res).lu().solve(&(-r))?;
-        p += dp;
-    }
-    None
 }
 
 /// The ODE state at s = 0 of the clamps' s = 0 frame: r(0) at its point, the

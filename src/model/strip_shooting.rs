@@ -19,7 +19,7 @@
 use crate::linalg::jet;
 use crate::model::energy::{RodEnergy, strip_energy, vertex_strains};
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::{NewtonShootingFailure, central_jacobian, hermite, newton_shooting, rk4};
+use crate::model::ode::{hermite, rk4};
 use crate::model::rod::{Clamps, RodState};
 use crate::model::shooting::end_mismatch;
 use nalgebra::{Matrix2, SVector, Vector2, Vector3, Vector6};
@@ -91,13 +91,13 @@ pub struct StripUnknowns {
 }
 
 impl StripUnknowns {
-    fn to_vector(self) -> Vector6<f64> {
+    pub(crate) fn to_vector(self) -> Vector6<f64> {
         Vector6::new(
             self.n0[0], self.n0[1], self.n0[2], self.u1, self.m2, self.u3,
         )
     }
 
-    fn from_vector(p: &Vector6<f64>) -> Self {
+    pub(crate) fn from_vector(p: &Vector6<f64>) -> Self {
         StripUnknowns {
             n0: p.fixed_rows::<3>(0).into(),
             u1: p[3],
@@ -282,31 +282,6 @@ impl StripProblem {
     /// The s = 1 residual of the solution from `p`.
     pub fn residual(&self, p: &StripUnknowns) -> Vector6<f64> {
         self.integrate(p).boundary_residual(&self.clamps)
-    }
-
-    /// Newton's method on the six s = 1 conditions from `start` (Jacobian by
-    /// central differences, as for the rod: a reference, not a solver), to a
-    /// residual below 1e-11.
-    pub fn refine(&self, start: StripUnknowns) -> Result<StripUnknowns, StripShootingError> {
-        let res = |p: &Vector6<f64>| self.residual(&StripUnknowns::from_vector(p));
-        match newton_shooting(
-            start.to_vector(),
-            res,
-            |q| central_jacobian(q, res),
-            1e-11,
-            30,
-            8,
-        ) {
-            Ok((p, _, _)) => Ok(StripUnknowns::from_vector(&p)),
-            Err(NewtonShootingFailure::Singular) => Err(StripShootingError::Singular),
-            Err(NewtonShootingFailure::NotConverged {
-                iterations,
-                residual,
-            }) => Err(StripShootingError::NotConverged {
-                iterations,
-                residual,
-            }),
-        }
     }
 }
 

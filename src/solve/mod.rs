@@ -3,6 +3,7 @@
 //! system of constrained laws, pseudo-arclength continuation.
 
 pub mod continuation;
+pub mod continuum;
 pub mod kkt;
 pub mod minimizer;
 pub mod newton;

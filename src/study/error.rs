@@ -31,7 +31,7 @@ pub enum StudyError {
     StripShooting(#[from] StripShootingError),
     /// The continuum check (adaptive shooting) failed.
     #[error(transparent)]
-    Continuum(#[from] crate::model::continuum::ContinuumError),
+    Continuum(#[from] crate::solve::continuum::ContinuumError),
     /// The study cannot go on, and says why.
     #[error("{0}")]
     Failed(String),

@@ -1,6 +1,6 @@
 //! The continuum polish of a branch's events: each fold, branch point,
 //! change of stability, wall and self-crossing that the discrete rod located
-//! is located again on the continuum branch (model::continuum_branch), from
+//! is located again on the continuum branch (solve::continuum::branch), from
 //! the discrete equilibrium there, to the integrator's tolerance. The two
 //! answers side by side give the discrete rod's error at its N, and the
 //! polished value carries its own error estimate (the change when the
@@ -8,11 +8,11 @@
 
 use crate::analysis::equilibrium::{Measure, self_approach};
 use crate::analysis::event::{ContinuumEvent, Event, EventKind};
-use crate::model::continuum::Unknowns;
-use crate::model::continuum_branch::{
+use crate::model::rod::{Parameter, RodModel, RodState};
+use crate::solve::continuum::Unknowns;
+use crate::solve::continuum::branch::{
     BranchPoint, ContinuumBranch, Located, PARAMETER, TestFunction, singular_borders,
 };
-use crate::model::rod::{Parameter, RodModel, RodState};
 use rayon::prelude::*;
 
 /// Tolerance of the integrator for the polish (its error estimate comes from

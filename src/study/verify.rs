@@ -17,9 +17,9 @@
 use crate::analysis::equilibrium::Equilibrium;
 use crate::geometry::closure::{closure_knot_along, ray_closure};
 use crate::geometry::writhe::writhe_closed;
-use crate::model::continuum::{Continuum, Polished, Unknowns};
 use crate::model::rod::{Law, Parameter};
 use crate::scene::{InitialShape, Scene};
+use crate::solve::continuum::{Continuum, Polished, Unknowns};
 use crate::study::error::{Context, Result, StudyError, describe, fail};
 use crate::study::polish::FOLD_RESOLUTION;
 use crate::study::start::equilibrium_near_start;

@@ -4,9 +4,10 @@
 use super::format::{error_cells, norm3};
 use crate::analysis::equilibrium::Equilibrium;
 use crate::model::rod::RodModel;
-use crate::model::shooting::{ShootingSolution, refine_shooting};
+use crate::model::shooting::ShootingSolution;
 use crate::report::error::{Context, Result};
 use crate::scene::{InitialShape, Scene};
+use crate::solve::continuum::shooting::refine_shooting;
 use crate::study::start::solve_scene;
 use nalgebra::Vector3;
 use std::fmt::Write;

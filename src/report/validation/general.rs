@@ -5,10 +5,10 @@
 
 use super::format::order;
 use crate::model::rod::{Parameter, RodState};
-use crate::model::shooting::refine_shooting_loaded;
 use crate::report::analytic::greenhill_constant;
 use crate::report::error::{ReportError, Result};
 use crate::scene::Scene;
+use crate::solve::continuum::shooting::refine_shooting_loaded;
 use crate::study::run::run_scene;
 use crate::study::start::solve_scene;
 use nalgebra::Vector3;

@@ -8,8 +8,8 @@
 //! N-independent value and a Richardson error estimate from nested point
 //! sets. Every root is checked to lie between the walls and near its start.
 
-use crate::model::continuum_branch::{BranchPoint, ContinuumBranch, PARAMETER, TestFunction};
 use crate::model::rod::{Clamps, Parameter, RodModel, RodState};
+use crate::solve::continuum::branch::{BranchPoint, ContinuumBranch, PARAMETER, TestFunction};
 use crate::study::boundary::condition::{Condition, OtherStrand};
 use crate::study::boundary::traced::{
     PolishedBoundary, PolishedCorner, Trail, TrailPoint, name_pieces,

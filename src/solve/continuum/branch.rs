@@ -12,8 +12,8 @@
 //! the height touches a wall, crossings where the signed distance of two
 //! strands vanishes.
 
-use crate::model::continuum::{Continuum, ContinuumError, Frame, Unknowns};
 use crate::model::rod::{Clamps, Parameter, RodModel};
+use crate::solve::continuum::{Continuum, ContinuumError, Frame, Unknowns};
 use nalgebra::{Matrix6, SMatrix, SVector, Vector3, Vector6};
 
 /// A point of the branch: the unknowns (0..6) and the parameter (6).

@@ -6,13 +6,26 @@
 //! `knotrod verify`: it shares the equations' right-hand sides with
 //! `shooting.rs` and `strip_shooting.rs` but neither their fixed-step RK4 nor
 //! anything of the discrete rod.
+//!
+//! The solvers of the continuum equations live here (`solve`), the equations
+//! themselves in `model` (`model::shooting`, `model::strip_shooting`: the
+//! right-hand sides, the s = 1 conditions, the strip's law): [`newton`] is
+//! Newton shooting, [`shooting`] refines the reference RK4 solutions by it,
+//! [`branch`] continues a continuum solution in a clamp parameter and locates
+//! events on it, [`stability`] counts and finds the frequencies of the
+//! linearised problem by shooting its determinant.
+
+pub mod branch;
+pub mod newton;
+pub mod shooting;
+pub mod stability;
 
 use crate::model::energy::strip_energy;
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::{NewtonShootingFailure, central_jacobian, newton_shooting};
 use crate::model::rod::{Clamps, EndKind, Law, RodModel};
 use crate::model::shooting::{OdeState, end_mismatch, rhs_loaded, start_frame};
 use crate::model::strip_shooting::{StripOdeState, sadowsky, strip_rhs};
+use crate::solve::continuum::newton::{NewtonShootingFailure, central_jacobian, newton_shooting};
 use nalgebra::{Matrix6, SVector, Vector3, Vector6};
 use ode_solvers::{Dop853, OutputType, System};
 use std::f64::consts::PI;
@@ -627,7 +640,8 @@ impl Continuum {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::shooting::{ShootingSolution, refine_shooting};
+    use crate::model::shooting::ShootingSolution;
+    use crate::solve::continuum::shooting::refine_shooting;
 
     fn appendix_d() -> (Continuum, Unknowns) {
         let clamps = Clamps::new(0.115, 0.05, 0.802);
