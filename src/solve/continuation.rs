@@ -11,7 +11,7 @@ use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::solve::kkt::Kkt;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::{FloorProbe, SolveError, floor_bound, judge};
-use crate::solve::step::StepControl;
+use crate::solve::step::{Acceptance, StepControl, Trial};
 use serde::{Deserialize, Serialize};
 
 /// Settings of one continuation.
@@ -500,6 +500,73 @@ impl<'a> Tracer<'a> {
         let mut v = sp.vectors[k].clone();
         v.resize(self.a.len(), 0.0);
         Ok((sp.values[k], v))
+    }
+
+    /// Cosine of the turn between the unit tangents of `a` and `b`, in the
+    /// arclength metric (dofs weighted 1/dofs, multipliers not counted).
+    pub fn turn(&self, a: &Point, b: &Point) -> f64 {
+        self.weight * self.dot_q(&a.tangent_q, &b.tangent_q) + a.tangent_p * b.tangent_p
+    }
+
+    /// The acceptance rule of a step on a branch of equilibria.
+    pub const ACCEPTANCE: Acceptance = Acceptance {
+        max_iterations: 6,
+        max_correction: 0.5,
+        min_turn: 0.9,
+        turn_free_below: 0.0,
+    };
+
+    /// One step along the branch from `from`: predictor, corrector,
+    /// acceptance ([`Tracer::ACCEPTANCE`]) and step-size control, halving
+    /// until a step is accepted. Returns the new point and the arclength it
+    /// lies from `from`; None when the step fell below `min_step` (the branch
+    /// is lost).
+    pub fn advance(&mut self, from: &Point, step: &mut StepControl) -> Option<(Point, f64)> {
+        step.advance(&Self::ACCEPTANCE, |sigma| {
+            let b = self.correct(from, sigma, None)?;
+            Ok::<_, ContinuationError>(Trial {
+                iterations: b.iterations,
+                correction: b.correction,
+                turn: self.turn(from, &b),
+                point: b,
+            })
+        })
+        .ok()
+    }
+
+    /// The first point of a branch leaving the branch point `bp` along the
+    /// null vector `null` (sign ±1), `sigma` away.
+    pub fn switch(
+        &mut self,
+        bp: &Point,
+        null: &[f64],
+        sign: f64,
+        sigma: f64,
+    ) -> Result<Point, ContinuationError> {
+        let norm = self.weighted_norm(null);
+        // the null vector as the tangent, which also orients the new branch
+        let fake = Point {
+            tangent_q: null.iter().map(|x| sign * x / norm).collect(),
+            tangent_p: 0.0,
+            ..bp.clone()
+        };
+        self.correct(&fake, sigma, None)
+    }
+
+    /// Newton at the parameter value `target` from the branch point `near`:
+    /// the corrector along the parameter axis.
+    pub fn settle_at_parameter(
+        &mut self,
+        near: &Point,
+        target: f64,
+    ) -> Result<Point, ContinuationError> {
+        let axis = Point {
+            tangent_q: vec![0.0; near.tangent_q.len()],
+            tangent_p: 1.0,
+            ..near.clone()
+        };
+        let pn = self.parameter_of(&near.state);
+        self.correct(&axis, target - pn, None)
     }
 
     /// Weighted norm of a dof vector.

@@ -181,13 +181,8 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 for sign in [1.0, -1.0] {
                     let b = self.next_branch;
                     self.next_branch += 1;
-                    let norm = self.tracer.weighted_norm(&null);
-                    let fake = Point {
-                        tangent_q: null.iter().map(|x| sign * x / norm).collect(),
-                        tangent_p: 0.0,
-                        ..bp.clone()
-                    };
-                    match self.tracer.correct(&fake, self.options.settings.step, None) {
+                    let sigma = self.options.settings.step;
+                    match self.tracer.switch(&bp, &null, sign, sigma) {
                         Ok(p) if self.in_range(&p) => self.trace(p, b, 0, true)?,
                         Ok(_) => {}
                         Err(e) => self.record(
@@ -216,32 +211,20 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             if !self.in_range(&a) {
                 break;
             }
-            let b = match self.tracer.correct(&a, step.length, None) {
-                // few corrector iterations, a small correction and a small
-                // turn of the tangent: the step stayed on this part of the branch
-                Ok(b)
-                    if b.iterations <= 6 && b.correction < 0.5 && self.tracer_dot(&a, &b) > 0.9 =>
-                {
-                    b
-                }
-                _ => {
-                    if !step.shrink() {
-                        self.record(
-                            EventKind::End,
-                            &a,
-                            branch,
-                            "step below min_step: branch lost".into(),
-                        );
-                        break;
-                    }
-                    continue;
-                }
+            let Some((b, ds)) = self.tracer.advance(&a, &mut step) else {
+                self.record(
+                    EventKind::End,
+                    &a,
+                    branch,
+                    "step below min_step: branch lost".into(),
+                );
+                break;
             };
             let eq = self.measure(&b, branch, leg)?;
             let wb = TestValues::of(&eq, &self.options.measure);
             let found = self.events.len();
             if self.options.locate_events {
-                self.locate_events(&a, &b, &wa, &wb, step.length, branch)?;
+                self.locate_events(&a, &b, &wa, &wb, ds, branch)?;
             }
             (self.observer)(eq)?;
             if self.events[found..]
@@ -250,22 +233,10 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             {
                 break;
             }
-            step.accepted(b.iterations);
             a = b;
             wa = wb;
         }
         Ok(())
-    }
-
-    fn tracer_dot(&self, a: &Point, b: &Point) -> f64 {
-        let w = 1.0 / a.tangent_q.len() as f64;
-        w * a
-            .tangent_q
-            .iter()
-            .zip(&b.tangent_q)
-            .map(|(x, y)| x * y)
-            .sum::<f64>()
-            + a.tangent_p * b.tangent_p
     }
 
     /// The events between the consecutive points `a` and `b` (test values

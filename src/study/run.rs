@@ -5,7 +5,7 @@ use crate::analysis::equilibrium::analyse;
 use crate::analysis::event::{Event, label_events};
 use crate::model::rod::{Parameter, RodState};
 use crate::scene::{Direction, Scene};
-use crate::solve::continuation::{ContinuationSettings, Point, Tracer};
+use crate::solve::continuation::{ContinuationSettings, Tracer};
 use crate::solve::minimizer::Minimizer;
 use crate::study::branch::{BranchOptions, BranchRun, Observer};
 use crate::study::error::{Context, Result, fail};
@@ -32,17 +32,13 @@ pub fn continue_to(
     let mut step = settings.step_control();
     for _ in 0..settings.max_points {
         let pa = tracer.parameter_of(&a.state);
-        let b = match tracer.correct(&a, step.length, None) {
-            Ok(b) if b.iterations <= 6 => b,
-            _ => {
-                if !step.shrink() {
-                    fail!(
-                        "could not reach {} = {target}: branch lost at {pa}",
-                        parameter.name()
-                    );
-                }
-                continue;
-            }
+        // the one step rule of branches: a hairpin is refused, so the
+        // path turns back at a fold as a branch does
+        let Some((b, ds)) = tracer.advance(&a, &mut step) else {
+            fail!(
+                "could not reach {} = {target}: branch lost at {pa}",
+                parameter.name()
+            );
         };
         let pb = tracer.parameter_of(&b.state);
         if (pb - target) * (pa - target) <= 0.0 {
@@ -50,22 +46,15 @@ pub fn continue_to(
             // parameter: a corrector along the parameter axis
             let below = (pa - target).signum();
             let near = tracer
-                .locate(&a, step.length, &mut |t, p| {
+                .locate(&a, ds, &mut |t, p| {
                     (t.parameter_of(&p.state) - target).signum() == below
                 })
                 .context("locating the target value")?;
-            let axis = Point {
-                tangent_q: vec![0.0; near.tangent_q.len()],
-                tangent_p: 1.0,
-                ..near.clone()
-            };
-            let pn = tracer.parameter_of(&near.state);
             let p = tracer
-                .correct(&axis, target - pn, None)
+                .settle_at_parameter(&near, target)
                 .context("Newton at the target value")?;
             return Ok(p.state);
         }
-        step.accepted(b.iterations);
         a = b;
     }
     fail!(

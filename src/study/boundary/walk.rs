@@ -283,7 +283,7 @@ impl Walk<'_, '_> {
 
     /// The point of condition `c` on the line through `p` along `normal`
     /// (secant iteration from the slope `slope`), continued from `from`.
-    fn correct(
+    fn correct_on(
         &mut self,
         c: &mut Condition,
         from: &Site,
@@ -339,7 +339,7 @@ impl Walk<'_, '_> {
         let t = left_tangent(at.gradient);
         let slope = at.gradient[0].hypot(at.gradient[1]);
         let p = along(at.site.p, t, s);
-        self.correct(
+        self.correct_on(
             c,
             &at.site,
             p,
