@@ -8,8 +8,8 @@
 
 use crate::analysis::equilibrium::{Measure, self_approach};
 use crate::analysis::event::{ContinuumEvent, Event, EventKind, PolishFailure};
-use crate::model::continuum::Unknowns;
 use crate::model::continuum::ContinuumError;
+use crate::model::continuum::Unknowns;
 use crate::model::continuum_branch::{
     BranchError, BranchPoint, ContinuumBranch, Located, PARAMETER, TestFunction, singular_borders,
 };
@@ -195,8 +195,8 @@ fn test_function(
             Ok(TestFunction::Wall { top: on_top, s })
         }
         Class::Crossing => {
-            let approach =
-                self_approach(state, measure).ok_or(PolishError::Event(PolishFailure::NoSelfApproach))?;
+            let approach = self_approach(state, measure)
+                .ok_or(PolishError::Event(PolishFailure::NoSelfApproach))?;
             // a strand passing through a ray, not through the centreline
             if approach.distance > 2.0 / state.segments() as f64 {
                 return Err(PolishError::Event(PolishFailure::RayCrossing {
@@ -296,13 +296,11 @@ pub(crate) fn locate_root(
     } else {
         1e-7
     } * scale;
-    let coarse = branch
-        .locate(z, held, 1e-4 * scale, resolution, test)?;
+    let coarse = branch.locate(z, held, 1e-4 * scale, resolution, test)?;
     // the same root at a hundredth of the tolerance, from the first
     let fine_branch = branch.with_tolerance(branch.tolerance * 1e-2);
     let step = (10.0 * coarse.last_step.abs()).max(1e-8 * scale);
-    let fine = fine_branch
-        .locate(coarse.point, held, step, resolution, coarse.test.clone())?;
+    let fine = fine_branch.locate(coarse.point, held, step, resolution, coarse.test.clone())?;
     let error = (coarse.point[PARAMETER] - fine.point[PARAMETER]).abs()
         + (fine.point[PARAMETER] - fine.previous[PARAMETER]).abs();
     Ok(Root {
@@ -322,6 +320,7 @@ pub(crate) fn singular_at(
     let (_, j) = branch
         .problem(z[PARAMETER])
         .and_then(|pr| Ok(pr.linearise(&p)?))?;
-    let (left, right) = singular_borders(&j).ok_or(PolishError::Event(PolishFailure::NoSingularVectors))?;
+    let (left, right) =
+        singular_borders(&j).ok_or(PolishError::Event(PolishFailure::NoSingularVectors))?;
     Ok(TestFunction::Singular { left, right })
 }
