@@ -91,6 +91,48 @@ pub struct Event {
     /// The event located again on the continuum branch, when asked.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub continuum: Option<ContinuumEvent>,
+    /// Why the event could not be located again on the continuum branch,
+    /// when its polish was asked and failed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub not_polished: Option<PolishFailure>,
+}
+
+/// Why an event was not polished on the continuum branch (typed, so a
+/// reader can tell the kinds apart without parsing text).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum PolishFailure {
+    /// Walls and crossings of a ribbon have no continuum test function.
+    Ribbon,
+    /// The discrete centreline has no self-approach to start a crossing from.
+    NoSelfApproach,
+    /// The crossing is of a closing ray, not of the centreline's strands.
+    RayCrossing {
+        /// How far apart the centreline's strands are.
+        distance: f64,
+    },
+    /// The shooting Jacobian has no singular vectors to border it with.
+    NoSingularVectors,
+    /// The continuum branch (integrator, corrector or root finder) failed.
+    Continuum {
+        /// The solver's reason.
+        message: String,
+    },
+}
+
+impl std::fmt::Display for PolishFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PolishFailure::Ribbon => write!(f, "walls and crossings of a ribbon are not polished"),
+            PolishFailure::NoSelfApproach => write!(f, "no self-approach of the centreline"),
+            PolishFailure::RayCrossing { distance } => write!(
+                f,
+                "the centreline's strands are {distance:.2e} apart (a crossing of a ray is not polished)"
+            ),
+            PolishFailure::NoSingularVectors => write!(f, "no singular vectors"),
+            PolishFailure::Continuum { message } => write!(f, "{message}"),
+        }
+    }
 }
 
 /// An event located on the continuum branch (the Kirchhoff or strip
@@ -132,6 +174,7 @@ impl Event {
             detail,
             clamps: (!c.is_paper() || !c.scalars.is_unset()).then_some(*c),
             continuum: None,
+            not_polished: None,
         }
     }
 

@@ -239,6 +239,13 @@ fn print_comparison(
 
 /// The events located again on the continuum branch: the parameter there
 /// with its error estimate, beside the discrete rod's value.
+/// The event's polish failure as a suffix of its detail ("" when none).
+fn not_polished(e: &Event) -> String {
+    e.not_polished
+        .as_ref()
+        .map_or(String::new(), |f| format!("; not polished: {f}"))
+}
+
 fn print_polished(events: &[Event], out: &mut impl Write) -> std::io::Result<()> {
     let polished: Vec<(&Event, &crate::analysis::event::ContinuumEvent)> = events
         .iter()
@@ -292,8 +299,15 @@ pub fn print_events(events: &[Event], out: &mut impl Write) -> std::io::Result<(
     for e in events {
         writeln!(
             out,
-            "  {:<6} {:<13} {:>6} {:>9.5} {:>9.5} {:>8.4}  {}",
-            e.label, e.kind, e.branch, e.z_star, e.phi_over_2pi, e.twist, e.detail
+            "  {:<6} {:<13} {:>6} {:>9.5} {:>9.5} {:>8.4}  {}{}",
+            e.label,
+            e.kind,
+            e.branch,
+            e.z_star,
+            e.phi_over_2pi,
+            e.twist,
+            e.detail,
+            not_polished(e)
         )?;
     }
     print_polished(events, out)?;

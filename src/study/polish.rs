@@ -7,11 +7,11 @@
 //! tolerance falls a hundredfold).
 
 use crate::analysis::equilibrium::{Measure, self_approach};
-use crate::analysis::event::{ContinuumEvent, Event, EventKind};
+use crate::analysis::event::{ContinuumEvent, Event, EventKind, PolishFailure};
 use crate::model::rod::{Parameter, RodModel, RodState};
-use crate::solve::continuum::Unknowns;
+use crate::solve::continuum::{ContinuumError, Unknowns};
 use crate::solve::continuum::branch::{
-    BranchPoint, ContinuumBranch, Located, PARAMETER, TestFunction, singular_borders,
+    BranchError, BranchPoint, ContinuumBranch, Located, PARAMETER, TestFunction, singular_borders,
 };
 use rayon::prelude::*;
 
@@ -22,6 +22,67 @@ pub const POLISH_TOLERANCE: f64 = 1e-10;
 /// The resolution (relative) to which a fold is located in the unknown held
 /// there: the located state's error along the branch.
 pub const FOLD_RESOLUTION: f64 = 1e-7;
+
+/// Why an event or a boundary could not be polished on the continuum.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum PolishError {
+    /// The event has no continuum test (or its test cannot start there).
+    #[error("{0}")]
+    Event(PolishFailure),
+    /// The continuum branch failed.
+    #[error(transparent)]
+    Branch(#[from] BranchError),
+    /// A point of a traced boundary failed from both sides.
+    #[error("{first}; across the other way: {second}")]
+    BothWays {
+        /// Across the first way.
+        first: Box<PolishError>,
+        /// Across the other way.
+        second: Box<PolishError>,
+    },
+    /// A boundary point failed, and again from its nearest polished neighbour.
+    #[error("{first}; from the nearest polished point: {second}")]
+    FromNeighbour {
+        /// From the discrete point.
+        first: Box<PolishError>,
+        /// From the neighbour.
+        second: Box<PolishError>,
+    },
+    /// A failure with where it happened (a boundary's phase, piece, point).
+    #[error("{at}: {source}")]
+    At {
+        /// Where.
+        at: String,
+        /// What.
+        source: Box<PolishError>,
+    },
+}
+
+impl From<ContinuumError> for PolishError {
+    fn from(e: ContinuumError) -> Self {
+        PolishError::Branch(e.into())
+    }
+}
+
+impl PolishError {
+    /// The failure as data on an event.
+    pub fn failure(&self) -> PolishFailure {
+        match self {
+            PolishError::Event(f) => f.clone(),
+            e => PolishFailure::Continuum {
+                message: e.to_string(),
+            },
+        }
+    }
+
+    /// This failure, placed `at` a phase or point.
+    pub fn at(self, at: impl Into<String>) -> Self {
+        PolishError::At {
+            at: at.into(),
+            source: Box::new(self),
+        }
+    }
+}
 
 /// What kind of root an event is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,7 +104,7 @@ fn class(kind: EventKind) -> Option<Class> {
 /// Polish every event of `events` that has a continuum counterpart, from the
 /// equilibria `located` there (`located[k]` at `events[k]`), on the branch
 /// in `parameter` of `model`. Events at one place share one polish; one that
-/// cannot be polished says why in its detail.
+/// cannot be polished says why in its `not_polished`.
 pub fn polish_events(
     model: &RodModel,
     parameter: Parameter,
@@ -68,7 +129,7 @@ pub fn polish_events(
             None => groups.push((c, k, vec![k])),
         }
     }
-    let results: Vec<Result<ContinuumEvent, String>> = groups
+    let results: Vec<Result<ContinuumEvent, PolishError>> = groups
         .par_iter()
         .map(|(c, first, members)| {
             // a fold is a fold whichever event of its place is polished
@@ -80,7 +141,7 @@ pub fn polish_events(
         for &k in members {
             match &result {
                 Ok(c) => events[k].continuum = Some(c.clone()),
-                Err(why) => events[k].detail.push_str(&format!("; not polished: {why}")),
+                Err(why) => events[k].not_polished = Some(why.failure()),
             }
         }
     }
@@ -116,7 +177,7 @@ fn test_function(
     state: &RodState,
     measure: &Measure,
     c: Class,
-) -> Result<TestFunction, String> {
+) -> Result<TestFunction, PolishError> {
     match c {
         Class::Singular => singular_at(branch, z),
         Class::Wall => {
@@ -137,14 +198,13 @@ fn test_function(
             Ok(TestFunction::Wall { top: on_top, s })
         }
         Class::Crossing => {
-            let approach =
-                self_approach(state, measure).ok_or("no self-approach of the centreline")?;
+            let approach = self_approach(state, measure)
+                .ok_or(PolishError::Event(PolishFailure::NoSelfApproach))?;
             // a strand passing through a ray, not through the centreline
             if approach.distance > 2.0 / state.segments() as f64 {
-                return Err(format!(
-                    "the centreline's strands are {:.2e} apart (a crossing of a ray is not polished)",
-                    approach.distance
-                ));
+                return Err(PolishError::Event(PolishFailure::RayCrossing {
+                    distance: approach.distance,
+                }));
             }
             Ok(TestFunction::Crossing { s: approach.s })
         }
@@ -159,12 +219,11 @@ fn polish_one(
     state: &RodState,
     c: Class,
     fold: bool,
-) -> Result<ContinuumEvent, String> {
+) -> Result<ContinuumEvent, PolishError> {
     if measure.strip_width > 0.0 && c != Class::Singular {
-        return Err("walls and crossings of a ribbon are not polished".into());
+        return Err(PolishError::Event(PolishFailure::Ribbon));
     }
-    let branch = ContinuumBranch::new(model, state.clamps, parameter, POLISH_TOLERANCE)
-        .map_err(|e| e.to_string())?;
+    let branch = ContinuumBranch::new(model, state.clamps, parameter, POLISH_TOLERANCE)?;
     let discrete = parameter.value(&state.clamps);
     let mut z = BranchPoint::zeros();
     z.fixed_rows_mut::<6>(0)
@@ -173,7 +232,7 @@ fn polish_one(
     // hold the parameter, except at a fold: there the unknown the branch
     // moves along fastest (relative to its size)
     let held = if fold {
-        let t = branch.tangent(&z).map_err(|e| e.to_string())?;
+        let t = branch.tangent(&z)?;
         (0..6)
             .max_by(|&a, &b| {
                 let w = |k: usize| t[k].abs() / (1.0 + z[k].abs());
@@ -191,8 +250,7 @@ fn polish_one(
     let p: Unknowns = fine.point.fixed_rows::<6>(0).into();
     let twist = fine_branch
         .problem(value)
-        .and_then(|pr| Ok(pr.solve(&p, 0)?))
-        .map_err(|e| e.to_string())?
+        .and_then(|pr| Ok(pr.solve(&p, 0)?))?
         .twist;
     let arclengths = match &fine.test {
         TestFunction::Wall { s, .. } => vec![*s],
@@ -231,7 +289,7 @@ pub(crate) fn locate_root(
     z: BranchPoint,
     held: usize,
     test: TestFunction,
-) -> Result<Root, String> {
+) -> Result<Root, PolishError> {
     let scale = 1.0 + z[held].abs();
     // at a fold the parameter is stationary in the held unknown: an error δ
     // there moves it by O(δ²), so δ = 1e-7 suffices (and the test
@@ -241,15 +299,11 @@ pub(crate) fn locate_root(
     } else {
         FOLD_RESOLUTION
     } * scale;
-    let coarse = branch
-        .locate(z, held, 1e-4 * scale, resolution, test)
-        .map_err(|e| e.to_string())?;
+    let coarse = branch.locate(z, held, 1e-4 * scale, resolution, test)?;
     // the same root at a hundredth of the tolerance, from the first
     let fine_branch = branch.with_tolerance(branch.tolerance * 1e-2);
     let step = (10.0 * coarse.last_step.abs()).max(1e-8 * scale);
-    let fine = fine_branch
-        .locate(coarse.point, held, step, resolution, coarse.test.clone())
-        .map_err(|e| e.to_string())?;
+    let fine = fine_branch.locate(coarse.point, held, step, resolution, coarse.test.clone())?;
     let error = (coarse.point[PARAMETER] - fine.point[PARAMETER]).abs()
         + (fine.point[PARAMETER] - fine.previous[PARAMETER]).abs();
     Ok(Root {
@@ -264,12 +318,12 @@ pub(crate) fn locate_root(
 pub(crate) fn singular_at(
     branch: &ContinuumBranch,
     z: &BranchPoint,
-) -> Result<TestFunction, String> {
+) -> Result<TestFunction, PolishError> {
     let p: Unknowns = z.fixed_rows::<6>(0).into();
     let (_, j) = branch
         .problem(z[PARAMETER])
-        .and_then(|pr| Ok(pr.linearise(&p)?))
-        .map_err(|e| e.to_string())?;
-    let (left, right) = singular_borders(&j).ok_or("no singular vectors")?;
+        .and_then(|pr| Ok(pr.linearise(&p)?))?;
+    let (left, right) =
+        singular_borders(&j).ok_or(PolishError::Event(PolishFailure::NoSingularVectors))?;
     Ok(TestFunction::Singular { left, right })
 }

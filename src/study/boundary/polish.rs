@@ -84,7 +84,7 @@ impl Plane<'_> {
     ) -> Result<TestFunction, String> {
         match c {
             Condition::Wall => Ok(TestFunction::Walls),
-            Condition::Stability => singular_at(branch, z),
+            Condition::Stability => singular_at(branch, z).map_err(|e| e.to_string()),
             Condition::Crossing(s) => {
                 let OtherStrand::Segment(j) = s.other else {
                     return Err("a crossing of a clamp's ray is not polished".into());
@@ -184,7 +184,7 @@ impl Plane<'_> {
         test: TestFunction,
         normal: [f64; 2],
     ) -> Result<Polished, String> {
-        let root = locate_root(branch, z, PARAMETER, test)?;
+        let root = locate_root(branch, z, PARAMETER, test).map_err(|e| e.to_string())?;
         at[free] = root.fine.point[PARAMETER];
         Ok(Polished {
             at,
