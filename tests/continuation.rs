@@ -303,3 +303,55 @@ fn settling_at_new_clamps_finds_the_equilibrium_continuation_reaches() {
     let far = Clamps::new(0.3, 0.05, 1.1);
     assert!(tracer.settle_at(&start, far).is_err());
 }
+
+/// `continue_to` follows the branch through its turns as a branch does. The
+/// Appendix E knot (N = 100, φ/2π = 0.785) followed up in φ: φ rises to a
+/// symmetric branch point (0.7943), where the path turns back onto the mirror
+/// branch, falls to the fold F2 (0.7843, 0 → 1 negative eigenvalues) and rises
+/// again, unstable and unknotted past the crossing X. Asked for φ/2π = 0.80,
+/// which the stable knot never reaches, `continue_to` must take that S-path
+/// (two hairpins in φ) and end on its third leg: unstable, unknotted, with the
+/// branch's twist there — not a jump across either hairpin.
+#[test]
+fn continue_to_turns_back_at_a_hairpin_as_a_branch_does() {
+    use knotrod::analysis::equilibrium::analyse;
+    use knotrod::model::rod::Parameter;
+    use knotrod::solve::outcome::SolveReport;
+    use knotrod::study::run::continue_to;
+    use knotrod::study::start::starting_equilibrium;
+    let extra = "[continuation]\nparameter = \"phi\"\nrange = [0.5, 0.805]\ndirection = \"up\"\nswitch_branches = false\nstep = 0.02\nmax_step = 0.05\n";
+    let scene = paper_scene("scenes/appendix_e.toml", 100, extra);
+    let (points, events) = run(&scene);
+    let kinds: Vec<EventKind> = events.iter().map(|e| e.kind).collect();
+    let turn = kinds.iter().position(|k| *k == EventKind::BranchPoint);
+    let fold = kinds.iter().position(|k| *k == EventKind::Fold);
+    assert!(
+        matches!((turn, fold), (Some(t), Some(f)) if t < f),
+        "the S-path: a turn, then a fold: {kinds:?}"
+    );
+    // the branch crosses 0.80 once, on its third leg: interpolate its twist
+    let crossings: Vec<usize> = (1..points.len())
+        .filter(|&k| (points[k - 1].phi_over_2pi - 0.80) * (points[k].phi_over_2pi - 0.80) <= 0.0)
+        .collect();
+    assert_eq!(crossings.len(), 1, "φ = 0.80 met once along the branch");
+    let (a, b) = (&points[crossings[0] - 1], &points[crossings[0]]);
+    let w = (0.80 - a.phi_over_2pi) / (b.phi_over_2pi - a.phi_over_2pi);
+    let twist_on_branch = a.twist + w * (b.twist - a.twist);
+    // continue_to from the same start, straight to 0.80
+    let settings = scene.continuation.as_ref().unwrap().settings();
+    let (mut newton, start, _) = starting_equilibrium(&scene, None).unwrap();
+    let end = continue_to(&mut newton, start, Parameter::Phi, 0.80, &settings).unwrap();
+    let report = SolveReport::of_corrector(0, 0.0, 0.0);
+    let eq = analyse(&mut newton, &end, &report, &scene.measure()).unwrap();
+    assert!((eq.phi_over_2pi - 0.80).abs() < 1e-12);
+    assert_eq!(eq.negative_eigenvalues, 1, "the unstable third leg");
+    assert!(!eq.knotted, "past the crossing X: unknotted");
+    // the chord's error between branch points (steps ≤ 0.05) bounds the gap
+    let chord = (b.twist - a.twist).abs();
+    assert!(
+        (eq.twist - twist_on_branch).abs() < 0.05 * chord.max(1e-3),
+        "Tw {} vs the branch's {twist_on_branch} (chord {chord})",
+        eq.twist
+    );
+    assert_eq!((a.negative_eigenvalues, b.negative_eigenvalues), (1, 1));
+}

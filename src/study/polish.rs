@@ -9,10 +9,10 @@
 use crate::analysis::equilibrium::{Measure, self_approach};
 use crate::analysis::event::{ContinuumEvent, Event, EventKind, PolishFailure};
 use crate::model::rod::{Parameter, RodModel, RodState};
-use crate::solve::continuum::{ContinuumError, Unknowns};
 use crate::solve::continuum::branch::{
     BranchError, BranchPoint, ContinuumBranch, Located, PARAMETER, TestFunction, singular_borders,
 };
+use crate::solve::continuum::{ContinuumError, Unknowns};
 use rayon::prelude::*;
 
 /// Tolerance of the integrator for the polish (its error estimate comes from
