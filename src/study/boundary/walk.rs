@@ -8,13 +8,13 @@ use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::MapSpec;
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
-use crate::solve::step::StepControl;
+use crate::solve::step::{Acceptance, StepControl, Trial};
 use crate::study::boundary::condition::{
     Condition, Failure, OtherStrand, Strands, closest_strands, strand_distance,
 };
 use crate::study::boundary::polish::polish_boundary;
 use crate::study::boundary::traced::{Traced, Trail, TrailPoint, merge_crossings, name_pieces};
-use crate::study::error::{Context, Result, describe, fail};
+use crate::study::error::{Context, Result, StudyError, describe, fail};
 use crate::study::start::starting_equilibrium;
 
 #[derive(Clone)]
@@ -47,6 +47,15 @@ const CORRECTOR_TOL: f64 = 1e-9;
 const STABILITY_TOL: f64 = 1e-5;
 /// Forward-difference step of the lowest eigenvalue's gradient.
 const STABILITY_FD: f64 = 1e-4;
+/// The walk's step rule: the tangent may turn by at most acos 0.97 (14°) per
+/// step, except on steps below 1e-4 (a corner of the curve, not a jump);
+/// the secant corrector's iterations and move are bounded by the corrector.
+const WALK_ACCEPTANCE: Acceptance = Acceptance {
+    max_iterations: usize::MAX,
+    max_correction: f64::INFINITY,
+    min_turn: 0.97,
+    turn_free_below: 1e-4,
+};
 
 struct Walk<'t, 'a> {
     tracer: &'t mut Tracer<'a>,
@@ -490,9 +499,7 @@ fn walk_around(
         tour.check_budget(walk)?;
         let t = left_tangent(tour.at.gradient);
         let normal = unit(tour.at.gradient);
-        let Some((q, iterations, g)) = tour.advance(walk, t)? else {
-            continue;
-        };
+        let (q, sigma, g) = tour.advance(walk, t)?;
         if !walk.inside(q.p) {
             fail!(
                 "the good region reaches the map's range at ({:.5}, {:.5})",
@@ -502,7 +509,7 @@ fn walk_around(
         }
         match walk.failing(&q, Some(&tour.c), unit(g))? {
             None => {
-                if tour.closes(&q, t) {
+                if tour.closes(&q, t, sigma) {
                     let first = pieces[0].1[0].clone();
                     pieces.last_mut().unwrap().1.push(first);
                     return Ok(());
@@ -519,10 +526,9 @@ fn walk_around(
                     site: q,
                     gradient: g,
                 };
-                tour.step.accepted(iterations);
             }
             Some(failure) => {
-                tour.turn_at_corner(walk, q, failure, normal, pieces)?;
+                tour.turn_at_corner(walk, q, sigma, failure, normal, pieces)?;
                 on_point(tour.count, &tour.c.describe());
             }
         }
@@ -604,45 +610,44 @@ impl Tour {
     }
 
     /// The next point one step along the tangent `t`, corrected onto the
-    /// curve, with its corrector iterations and gradient; None when the step
-    /// was halved (the corrector failed or the curve turned too sharply).
-    fn advance(&mut self, walk: &mut Walk, t: [f64; 2]) -> Result<Option<(Site, usize, [f64; 2])>> {
-        let sigma = self.step.length;
-        let c = &mut self.c;
-        let attempt = walk
-            .correct_along(c, &self.at, sigma, sigma)
-            .and_then(|(q, it)| {
-                let g = walk.gradient(c, &q)?;
-                Ok((q, it, g))
-            });
-        match attempt {
-            Ok((q, it, g)) if sigma < 1e-4 || dot2(left_tangent(g), t) > 0.97 => {
-                Ok(Some((q, it, g)))
-            }
-            other => {
-                if !self.step.shrink() {
-                    let why = other
-                        .err()
-                        .map_or("the boundary turns too sharply".into(), |e| describe(&e));
-                    fail!(
-                        "boundary walk stopped on {} at ({:.5}, {:.5}): {why}",
-                        self.c.describe(),
-                        self.at.site.p[0],
-                        self.at.site.p[1]
-                    );
-                }
-                Ok(None)
+    /// curve, with the step it was found at and its gradient: the one step
+    /// loop of path following ([`StepControl::advance`]), halving until the
+    /// tangent turns by less than [`WALK_ACCEPTANCE`] allows.
+    fn advance(&mut self, walk: &mut Walk, t: [f64; 2]) -> Result<(Site, f64, [f64; 2])> {
+        let (c, at) = (&mut self.c, &self.at);
+        let found = self.step.advance(&WALK_ACCEPTANCE, |sigma| {
+            let (q, iterations) = walk.correct_along(c, at, sigma, sigma)?;
+            let g = walk.gradient(c, &q)?;
+            Ok::<_, StudyError>(Trial {
+                turn: dot2(left_tangent(g), t),
+                point: (q, g),
+                iterations,
+                correction: 0.0,
+            })
+        });
+        match found {
+            Ok(((q, g), sigma)) => Ok((q, sigma, g)),
+            Err(last) => {
+                let why = last.map_or("the boundary turns too sharply".into(), |e: StudyError| {
+                    describe(&e)
+                });
+                fail!(
+                    "boundary walk stopped on {} at ({:.5}, {:.5}): {why}",
+                    self.c.describe(),
+                    self.at.site.p[0],
+                    self.at.site.p[1]
+                );
             }
         }
     }
 
-    /// The walk closed: its start lies between the last point and `q`, on
-    /// the same kind of condition.
-    fn closes(&self, q: &Site, t: [f64; 2]) -> bool {
+    /// The walk closed: its start lies between the last point and `q` (a
+    /// step `sigma` along), on the same kind of condition.
+    fn closes(&self, q: &Site, t: [f64; 2], sigma: f64) -> bool {
         let first = self.first;
         let d0 = [first[0] - self.at.site.on[0], first[1] - self.at.site.on[1]];
         let d1 = [first[0] - q.on[0], first[1] - q.on[1]];
-        let near = d0[0].hypot(d0[1]) < 2.0 * self.step.length;
+        let near = d0[0].hypot(d0[1]) < 2.0 * sigma;
         self.count > 3
             && self.c.failure() == self.first_kind
             && near
@@ -651,16 +656,17 @@ impl Tour {
     }
 
     /// A corner: bisect along the curve to where another property fails
-    /// (first seen failing at `q`), and turn onto that property's condition.
+    /// (first seen failing at `q`, a step `sigma` along), and turn onto that
+    /// property's condition.
     fn turn_at_corner(
         &mut self,
         walk: &mut Walk,
         q: Site,
+        sigma: f64,
         first_failure: Failure,
         normal: [f64; 2],
         pieces: &mut Vec<Trail>,
     ) -> Result<()> {
-        let sigma = self.step.length;
         let (good, bad, failure, progress) =
             self.bisect_corner(walk, q, first_failure, normal, sigma)?;
         // a corner right at the previous one: the crossing taken there made
