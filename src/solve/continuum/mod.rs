@@ -643,6 +643,27 @@ mod tests {
     use crate::model::shooting::ShootingSolution;
     use crate::solve::continuum::shooting::refine_shooting;
 
+    /// An equation that depends on s (as natural strains varying along the
+    /// rod make the rod's): y' = (8 s⁷, cos s), integrated to 1e-12 in a few
+    /// steps. The crate's DOP853 evaluated its 12th stage at the step's start
+    /// (vendor/ode_solvers, c12 fixed): this took hundreds of steps or
+    /// stopped as "stiff".
+    #[test]
+    fn an_equation_that_depends_on_s_is_integrated_to_its_tolerance() {
+        let f = |s: f64, _: &SVector<f64, 2>| SVector::<f64, 2>::new(8.0 * s.powi(7), s.cos());
+        let (end, dense, steps) = integrate(SVector::<f64, 2>::zeros(), f, 1e-12, 5).unwrap();
+        assert!((end[0] - 1.0).abs() < 1e-12, "{}", end[0] - 1.0);
+        assert!(
+            (end[1] - 1f64.sin()).abs() < 1e-12,
+            "{}",
+            end[1] - 1f64.sin()
+        );
+        assert!(steps < 40, "{steps} steps");
+        // the dense output at s = 0.5 too
+        assert!((dense[2][0] - 0.5f64.powi(8)).abs() < 1e-10);
+        assert!((dense[2][1] - 0.5f64.sin()).abs() < 1e-10);
+    }
+
     fn appendix_d() -> (Continuum, Unknowns) {
         let clamps = Clamps::new(0.115, 0.05, 0.802);
         let c = Continuum {
