@@ -417,8 +417,9 @@ fn the_reader_sees_imports_through_groups_super_and_re_exports() {
 }
 
 /// One predictor-corrector loop: outside `src/solve/` nothing calls the
-/// corrector itself (it steps through `Tracer::advance`), and nothing but
-/// `StepControl::advance` halves or grows a step.
+/// corrector itself (it steps through `Tracer::advance`); that nothing but
+/// `StepControl::advance` halves or grows a step, the compiler sees to
+/// (`shrink` and `accepted` are private to solve/step.rs).
 #[test]
 fn only_solve_calls_the_corrector() {
     let files = read_crate();
@@ -426,10 +427,7 @@ fn only_solve_calls_the_corrector() {
     for (path, file) in &files {
         let p = path.to_string_lossy().replace('\\', "/");
         let in_solve = p.starts_with("solve/") || p.contains("/solve/");
-        let corrects = !in_solve && file.code.contains(".correct(");
-        let steps = !p.ends_with("solve/step.rs")
-            && (file.code.contains(".shrink()") || file.code.contains(".accepted("));
-        if corrects || steps {
+        if !in_solve && file.code.contains(".correct(") {
             offenders.push(p);
         }
     }

@@ -29,14 +29,14 @@ impl StepControl {
     }
 
     /// Halve the step after a failure; false once it falls below the smallest.
-    pub fn shrink(&mut self) -> bool {
+    fn shrink(&mut self) -> bool {
         self.length *= 0.5;
         self.length >= self.min
     }
 
     /// After a step accepted in `iterations` corrector iterations: grow it if
     /// that was easy.
-    pub fn accepted(&mut self, iterations: usize) {
+    fn accepted(&mut self, iterations: usize) {
         if iterations <= self.easy {
             self.length = (self.length * self.growth).min(self.max);
         }
