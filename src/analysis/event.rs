@@ -2,6 +2,7 @@
 //! where, and the paper's labels (W1, W2, X, S, F1, J1, ...).
 
 use crate::model::rod::{Clamps, Parameter};
+use crate::solve::event::Vanishing;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
@@ -42,6 +43,21 @@ impl EventKind {
             EventKind::KnotChange => "knot_change",
             EventKind::End => "end",
             EventKind::ContactLost => "contact_lost",
+        }
+    }
+
+    /// The quantity that vanishes at an event of this kind (none for a jump,
+    /// an end or a lost contact, which no test function locates). A ribbon
+    /// touching itself is recorded as a crossing: its quantity is then the
+    /// ribbon's, [`Vanishing::RibbonGap`], told by the strip's width.
+    pub fn vanishing(self) -> Option<Vanishing> {
+        match self {
+            EventKind::Fold | EventKind::Stability | EventKind::BranchPoint => {
+                Some(Vanishing::Singularity)
+            }
+            EventKind::Wall => Some(Vanishing::WallGap),
+            EventKind::Crossing | EventKind::KnotChange => Some(Vanishing::StrandGap),
+            EventKind::Jump | EventKind::End | EventKind::ContactLost => None,
         }
     }
 

@@ -1,9 +1,11 @@
 //! Solvers of the discrete rod: one minimiser (Newton, and SQP for
 //! constrained laws and contact) behind [`minimizer::Minimizer`], the KKT
-//! system of constrained laws, pseudo-arclength continuation.
+//! system of constrained laws, pseudo-arclength continuation, and the vocabulary of
+//! events ([`event::Vanishing`]).
 
 pub mod continuation;
 pub mod continuum;
+pub mod event;
 pub mod kkt;
 pub mod minimizer;
 pub mod newton;

@@ -13,7 +13,12 @@ use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
 use crate::study::error::{Context, Result};
 
-/// Test functions watched along a branch.
+/// The discrete values of the [`Vanishing`] quantities watched along a
+/// branch: `wall` the wall gap, `knot` and `link` the strand gap (they jump
+/// where two strands pass through each other), `touching` the ribbon gap;
+/// the singularity is watched by the points' tangent and inertia.
+///
+/// [`Vanishing`]: crate::solve::event::Vanishing
 #[derive(Clone, Debug)]
 struct TestValues {
     wall: f64,

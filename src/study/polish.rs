@@ -13,6 +13,7 @@ use crate::solve::continuum::branch::{
     BranchError, BranchPoint, ContinuumBranch, Located, PARAMETER, TestFunction, singular_borders,
 };
 use crate::solve::continuum::{ContinuumError, Unknowns};
+use crate::solve::event::Vanishing;
 use rayon::prelude::*;
 
 /// Tolerance of the integrator for the polish (its error estimate comes from
@@ -84,23 +85,6 @@ impl PolishError {
     }
 }
 
-/// What kind of root an event is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Class {
-    Singular,
-    Wall,
-    Crossing,
-}
-
-fn class(kind: EventKind) -> Option<Class> {
-    match kind {
-        EventKind::Fold | EventKind::Stability | EventKind::BranchPoint => Some(Class::Singular),
-        EventKind::Wall => Some(Class::Wall),
-        EventKind::Crossing | EventKind::KnotChange => Some(Class::Crossing),
-        _ => None,
-    }
-}
-
 /// Polish every event of `events` that has a continuum counterpart, from the
 /// equilibria `located` there (`located[k]` at `events[k]`), on the branch
 /// in `parameter` of `model`. Events at one place share one polish; one that
@@ -113,9 +97,11 @@ pub fn polish_events(
     located: &[RodState],
 ) {
     // one polish per (branch, class, place)
-    let mut groups: Vec<(Class, usize, Vec<usize>)> = Vec::new();
+    let mut groups: Vec<(Vanishing, usize, Vec<usize>)> = Vec::new();
     for (k, e) in events.iter().enumerate() {
-        let Some(c) = class(e.kind) else { continue };
+        let Some(c) = e.kind.vanishing() else {
+            continue;
+        };
         if k >= located.len() {
             continue;
         }
@@ -170,17 +156,17 @@ pub fn discrete_unknowns(model: &RodModel, state: &RodState) -> Unknowns {
     }
 }
 
-/// The test function of an event of class `c` at the discrete `state`.
+/// The test function of an event whose quantity `c` vanishes at the discrete `state`.
 fn test_function(
     branch: &ContinuumBranch,
     z: &BranchPoint,
     state: &RodState,
     measure: &Measure,
-    c: Class,
+    c: Vanishing,
 ) -> Result<TestFunction, PolishError> {
     match c {
-        Class::Singular => singular_at(branch, z),
-        Class::Wall => {
+        Vanishing::Singularity => singular_at(branch, z),
+        Vanishing::WallGap => {
             // the interior node nearest a wall
             let (points, arc) = state.centreline();
             let (origin, axis) = (state.clamps.start_point(), state.clamps.start_tangent());
@@ -197,7 +183,7 @@ fn test_function(
             }
             Ok(TestFunction::Wall { top: on_top, s })
         }
-        Class::Crossing => {
+        Vanishing::StrandGap => {
             let approach = self_approach(state, measure)
                 .ok_or(PolishError::Event(PolishFailure::NoSelfApproach))?;
             // a strand passing through a ray, not through the centreline
@@ -208,6 +194,11 @@ fn test_function(
             }
             Ok(TestFunction::Crossing { s: approach.s })
         }
+        // no event kind carries these on a centreline (polish_one turns
+        // a ribbon's events away first)
+        Vanishing::RibbonGap | Vanishing::StrandMerger => {
+            Err(PolishError::Event(PolishFailure::Ribbon))
+        }
     }
 }
 
@@ -217,10 +208,10 @@ fn polish_one(
     parameter: Parameter,
     measure: &Measure,
     state: &RodState,
-    c: Class,
+    c: Vanishing,
     fold: bool,
 ) -> Result<ContinuumEvent, PolishError> {
-    if measure.strip_width > 0.0 && c != Class::Singular {
+    if measure.strip_width > 0.0 && c != Vanishing::Singularity {
         return Err(PolishError::Event(PolishFailure::Ribbon));
     }
     let branch = ContinuumBranch::new(model, state.clamps, parameter, POLISH_TOLERANCE)?;

@@ -14,6 +14,7 @@
 
 use crate::model::rod::{Clamps, Parameter, RodModel};
 use crate::solve::continuum::{Continuum, ContinuumError, Frame, Unknowns};
+use crate::solve::event::Vanishing;
 use nalgebra::{Matrix6, SMatrix, SVector, Vector3, Vector6};
 
 /// A point of the branch: the unknowns (0..6) and the parameter (6).
@@ -60,7 +61,8 @@ pub struct ContinuumBranch<'a> {
     pub tolerance: f64,
 }
 
-/// What vanishes at an event.
+/// A test function of the continuum branch: a [`Vanishing`] quantity with
+/// what it needs to be evaluated (borders, arclengths to seek from).
 #[derive(Clone, Debug, PartialEq)]
 pub enum TestFunction {
     /// The shooting Jacobian is singular (fold, branch point, change of
@@ -104,6 +106,18 @@ pub enum TestFunction {
         /// Arclengths of the critical point (updated as it moves).
         s: [f64; 2],
     },
+}
+
+impl TestFunction {
+    /// The quantity it measures.
+    pub fn vanishing(&self) -> Vanishing {
+        match self {
+            TestFunction::Singular { .. } => Vanishing::Singularity,
+            TestFunction::Wall { .. } | TestFunction::Walls => Vanishing::WallGap,
+            TestFunction::Crossing { .. } => Vanishing::StrandGap,
+            TestFunction::Merging { .. } => Vanishing::StrandMerger,
+        }
+    }
 }
 
 /// An event located on the continuum branch.

@@ -2,6 +2,7 @@
 //! strands (with their flip images), stability.
 
 use crate::geometry::distance::segment_distance;
+use crate::solve::event::Vanishing;
 use nalgebra::Vector3;
 
 /// The other strand of a crossing.
@@ -39,30 +40,13 @@ pub enum Condition {
     Stability,
 }
 
-/// The property of a good knot that fails first at a state.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Failure {
-    Wall,
-    Knot,
-    Stability,
-}
-
-impl std::fmt::Display for Failure {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Failure::Wall => "it is not between the walls",
-            Failure::Knot => "its ray closure is not a trefoil",
-            Failure::Stability => "it is unstable",
-        })
-    }
-}
-
 impl Condition {
-    pub(super) fn failure(&self) -> Failure {
+    /// The quantity that vanishes on it.
+    pub fn vanishing(&self) -> Vanishing {
         match self {
-            Condition::Wall => Failure::Wall,
-            Condition::Crossing(_) => Failure::Knot,
-            Condition::Stability => Failure::Stability,
+            Condition::Wall => Vanishing::WallGap,
+            Condition::Crossing(_) => Vanishing::StrandGap,
+            Condition::Stability => Vanishing::Singularity,
         }
     }
 

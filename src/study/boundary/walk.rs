@@ -8,9 +8,10 @@ use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::MapSpec;
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
+use crate::solve::event::Vanishing;
 use crate::solve::step::{Acceptance, StepControl, Trial};
 use crate::study::boundary::condition::{
-    Condition, Failure, OtherStrand, Strands, closest_strands, strand_distance,
+    Condition, OtherStrand, Strands, closest_strands, strand_distance,
 };
 use crate::study::boundary::polish::polish_boundary;
 use crate::study::boundary::traced::{Traced, Trail, TrailPoint, merge_crossings, name_pieces};
@@ -231,39 +232,41 @@ impl Walk<'_, '_> {
         site: &Site,
         on: Option<&Condition>,
         normal: [f64; 2],
-    ) -> Result<Option<Failure>> {
-        let skip = on.map(Condition::failure);
+    ) -> Result<Option<Vanishing>> {
+        let skip = on.map(Condition::vanishing);
         let state = &site.point.state;
         let (lo, hi) = state.z_range();
-        if skip != Some(Failure::Wall) && (lo <= 0.0 || hi >= state.clamps.top_wall()) {
-            return Ok(Some(Failure::Wall));
+        if skip != Some(Vanishing::WallGap) && (lo <= 0.0 || hi >= state.clamps.top_wall()) {
+            return Ok(Some(Vanishing::WallGap));
         }
-        if skip != Some(Failure::Stability) && site.point.negative_count > 0 {
-            return Ok(Some(Failure::Stability));
+        if skip != Some(Vanishing::Singularity) && site.point.negative_count > 0 {
+            return Ok(Some(Vanishing::Singularity));
         }
         let good = self.measure.good.clone();
         let trefoil = |s: &RodState| {
             let knot = closure_knot_along(&s.centreline().0, s.ray_directions()).ok();
             good.is_knot(knot.as_ref().map(|k| k.alexander.as_slice()))
         };
-        let knotted = if skip == Some(Failure::Knot) {
+        let knotted = if skip == Some(Vanishing::StrandGap) {
             let off = self.equilibrium_at(site, along(site.p, normal, FD))?;
             trefoil(&off.point.state)
         } else {
             trefoil(state)
         };
-        Ok((!knotted).then_some(Failure::Knot))
+        Ok((!knotted).then_some(Vanishing::StrandGap))
     }
 
     /// The condition behind a failure at the site `bad`, just past a corner
     /// (or the first boundary). A crossing's strands are those closest there,
     /// other than those in `except` (the crossing the walk is on, and those
     /// tried at this corner); its sign by [`Walk::orient_at`].
-    fn condition_of(&mut self, failure: Failure, bad: &Site, except: &[Strands]) -> Condition {
+    fn condition_of(&mut self, failure: Vanishing, bad: &Site, except: &[Strands]) -> Condition {
         match failure {
-            Failure::Wall => Condition::Wall,
-            Failure::Stability => Condition::Stability,
-            Failure::Knot => {
+            Vanishing::WallGap => Condition::Wall,
+            Vanishing::Singularity => Condition::Stability,
+            // `failing` tells only walls, stability and the knot apart (maps
+            // of ribbons are refused), so the rest is the knot's crossing
+            Vanishing::StrandGap | Vanishing::RibbonGap | Vanishing::StrandMerger => {
                 let (points, arc) = bad.point.state.centreline();
                 let (first, other) =
                     closest_strands(&points, &arc, self.measure.self_distance_gap, except);
@@ -436,11 +439,12 @@ pub fn trace_island(
     if let Some(f) = walk.failing(&start, None, [0.0, 0.0])? {
         fail!(
             "the boundary walk starts from a good knot (map.trace_from, or the scene's start); \
-             at {} = {}, {} = {} {f}",
+             at {} = {}, {} = {} {}",
             label(swept),
             p0[0],
             label(along),
-            p0[1]
+            p0[1],
+            f.failure()
         );
     }
     let mut pieces: Vec<Trail> = Vec::new();
@@ -479,7 +483,7 @@ fn walk_around(
     let (c, at) = first_boundary(walk, start)?;
     let mut tour = Tour {
         first: at.site.on,
-        first_kind: c.failure(),
+        first_kind: c.vanishing(),
         c,
         at,
         step: StepControl::new(FIRST_STEP, MIN_STEP, walk.max_step, 1.4, 4),
@@ -557,7 +561,7 @@ fn first_boundary(walk: &mut Walk, start: Site) -> Result<(Condition, Step)> {
     };
     let reference = good.clone();
     let (mut lo, mut hi, failure) = (good, bad.0, bad.1);
-    let tol = if failure == Failure::Stability {
+    let tol = if failure == Vanishing::Singularity {
         STABILITY_TOL
     } else {
         1e-9
@@ -591,7 +595,7 @@ struct Tour {
     tried: Vec<Strands>,
     /// Where the walk started, and on which kind of condition.
     first: [f64; 2],
-    first_kind: Failure,
+    first_kind: Vanishing,
 }
 
 impl Tour {
@@ -649,7 +653,7 @@ impl Tour {
         let d1 = [first[0] - q.on[0], first[1] - q.on[1]];
         let near = d0[0].hypot(d0[1]) < 2.0 * sigma;
         self.count > 3
-            && self.c.failure() == self.first_kind
+            && self.c.vanishing() == self.first_kind
             && near
             && dot2(d0, t) > 0.0
             && dot2(d1, t) <= 0.0
@@ -663,7 +667,7 @@ impl Tour {
         walk: &mut Walk,
         q: Site,
         sigma: f64,
-        first_failure: Failure,
+        first_failure: Vanishing,
         normal: [f64; 2],
         pieces: &mut Vec<Trail>,
     ) -> Result<()> {
@@ -733,14 +737,14 @@ impl Tour {
         &mut self,
         walk: &mut Walk,
         q: Site,
-        first_failure: Failure,
+        first_failure: Vanishing,
         normal: [f64; 2],
         sigma: f64,
-    ) -> Result<(Site, Site, Failure, f64)> {
+    ) -> Result<(Site, Site, Vanishing, f64)> {
         let (mut a, mut b) = (0.0, sigma);
         let mut good = self.at.site.clone();
         let (mut bad, mut failure) = (q, first_failure);
-        let tol = if first_failure == Failure::Stability {
+        let tol = if first_failure == Vanishing::Singularity {
             STABILITY_TOL
         } else {
             1e-8
