@@ -130,3 +130,30 @@ fn the_discrete_strip_converges_to_the_continuum_frequency() {
     assert_eq!(omega["agrees"], true);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_conjugate_point_just_short_of_the_clamp_is_counted() {
+    // point 72 of the Figure 3 branch (scenes/verify/branch_100.csv), just
+    // past its change of stability: the discrete rod's lowest ω² is -5.856,
+    // -2.312, -1.436 at N = 100, 200, 400 (Richardson -1.14 ± 0.29), so one
+    // negative direction, whose conjugate point at ω² = 0 lies in the last
+    // of the samples of det B(s) before s = 1
+    let text = std::fs::read_to_string("scenes/appendix_d.toml").unwrap();
+    let text = text
+        .replace("phi_over_2pi = 0.802", "phi_over_2pi = 0.7506636511")
+        .replace(
+            "n0 = [-24.743, 17.772, 37.145]",
+            "n0 = [-34.52327899, 34.37962166, 34.94657721]",
+        )
+        .replace(
+            "m0 = [7.5317, -8.7100, 4.529]",
+            "m0 = [4.676547798, -9.843758839, 9.862992239]",
+        );
+    let scene = Scene::parse(&text).unwrap();
+    let (c, p) = polished(&scene);
+    let spectrum = c.lowest_frequencies(&p, 1, 10.0).unwrap();
+    eprintln!("{spectrum:?}");
+    assert_eq!(spectrum.negative, 1);
+    let (l1, e1) = (spectrum.values[0], spectrum.errors[0]);
+    assert!((l1 + 1.14).abs() < 0.29 + e1, "ω² = {l1} ± {e1}");
+}

@@ -166,9 +166,16 @@ impl Continuum {
         if dets.iter().any(|d| !d.is_finite()) {
             return Err(ContinuumError::Singular);
         }
-        // a zero at s = 1 itself is the eigenvalue, not below it
-        let inner = &dets[..SAMPLES - 1];
-        Ok(inner
+        // a conjugate point in the last interval (SAMPLES − 1)/SAMPLES..1 is
+        // below `lambda` too (an eigenvalue just below it puts its conjugate
+        // point just short of s = 1); only a zero at s = 1 itself is the
+        // eigenvalue, not below it
+        let counted = if dets[SAMPLES - 1] == 0.0 {
+            &dets[..SAMPLES - 1]
+        } else {
+            &dets[..]
+        };
+        Ok(counted
             .windows(2)
             .filter(|w| (w[0] > 0.0) != (w[1] > 0.0))
             .count())
