@@ -144,19 +144,12 @@ pub(crate) const VARIATIONAL: usize = 19 * 7;
 
 struct Rhs<F>(F);
 
-impl<F, const D: usize> System<f64, ode_solvers::SVector<f64, D>> for Rhs<F>
+impl<F, const D: usize> System<f64, SVector<f64, D>> for Rhs<F>
 where
     F: Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
 {
-    fn system(
-        &self,
-        s: f64,
-        y: &ode_solvers::SVector<f64, D>,
-        dy: &mut ode_solvers::SVector<f64, D>,
-    ) {
-        // ode_solvers builds on another nalgebra: the vectors cross as slices
-        let f = (self.0)(s, &SVector::from_column_slice(y.as_slice()));
-        dy.as_mut_slice().copy_from_slice(f.as_slice());
+    fn system(&self, s: f64, y: &SVector<f64, D>, dy: &mut SVector<f64, D>) {
+        *dy = (self.0)(s, y);
     }
 }
 
@@ -176,16 +169,12 @@ fn integrate<const D: usize>(
     if samples < 2 {
         return Ok((end, vec![], steps));
     }
-    let start = ode_solvers::SVector::<f64, D>::from_column_slice(y0.as_slice());
+    let start = y0;
     let dx = 1.0 / (samples - 1) as f64;
     // (Dense is the crate's default output)
     let mut solver = Dop853::new(Rhs(&f), 0.0, 1.0, dx, start, tolerance, tolerance);
     solver.integrate().map_err(integration_error)?;
-    let mut dense: Vec<SVector<f64, D>> = solver
-        .y_out()
-        .iter()
-        .map(|y| SVector::from_column_slice(y.as_slice()))
-        .collect();
+    let mut dense: Vec<SVector<f64, D>> = solver.y_out().to_vec();
     // the crate's dense output at s = 1 itself is an extrapolation (errors
     // of 1e-10 seen); the step's own y(1) is exact to the tolerance
     if let Some(last) = dense.last_mut() {
@@ -222,7 +211,7 @@ pub(crate) fn integrate_stops<const D: usize>(
     tolerance: f64,
     stops: &[f64],
 ) -> Result<(Vec<SVector<f64, D>>, u32), ContinuumError> {
-    let mut y = ode_solvers::SVector::<f64, D>::from_column_slice(y0.as_slice());
+    let mut y = y0;
     let mut from = 0.0;
     let mut out = Vec::with_capacity(stops.len());
     let mut steps = 0;
@@ -269,7 +258,7 @@ pub(crate) fn integrate_stops<const D: usize>(
                 });
             }
         }
-        out.push(SVector::from_column_slice(y.as_slice()));
+        out.push(y);
         from = to;
     }
     Ok((out, steps))
