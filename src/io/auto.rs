@@ -247,12 +247,6 @@ pub fn read_solutions_file(path: &Path) -> Result<Vec<AutoSolution>, AutoError> 
 /// The solutions of `text` (the file `path`, for messages).
 pub fn parse_solutions(path: &Path, text: &str) -> Result<Vec<AutoSolution>, AutoError> {
     let lines: Vec<&str> = text.lines().collect();
-    let bad = |line: usize, field: &str, reason: String| AutoError::Format {
-        path: path.into(),
-        line,
-        field: field.into(),
-        reason,
-    };
     let mut out = Vec::new();
     let mut i = 0;
     while i < lines.len() {
@@ -260,7 +254,45 @@ pub fn parse_solutions(path: &Path, text: &str) -> Result<Vec<AutoSolution>, Aut
             i += 1;
             continue;
         }
-        let line = i + 1;
+        let (solution, next) = solution_at(path, &lines, i)?;
+        out.push(solution);
+        if out.len() > crate::io::verify_file::MAX_SOLUTIONS {
+            return Err(AutoError::Format {
+                path: path.into(),
+                line: i + 1,
+                field: "LAB".into(),
+                reason: format!(
+                    "more than {} solutions; the most read is that",
+                    crate::io::verify_file::MAX_SOLUTIONS
+                ),
+            });
+        }
+        i = next;
+    }
+    Ok(out)
+}
+
+/// A solution's header: its 12 (or 16) integers and the sizes checked
+/// against the most a file may hold.
+struct Header {
+    values: Vec<i64>,
+    ntpl: usize,
+    nar: usize,
+    npar: usize,
+    nfpr: usize,
+    nrowpr: usize,
+    ntst: usize,
+    ncol: usize,
+}
+
+impl Header {
+    /// The header on line `line` (1-based) of `lines`.
+    fn read(
+        lines: &[&str],
+        line: usize,
+        bad: &dyn Fn(usize, &str, String) -> AutoError,
+    ) -> Result<Header, AutoError> {
+        let i = line - 1;
         let header: Vec<i64> = lines[i]
             .split_whitespace()
             .map(|w| w.parse::<i64>())
@@ -303,112 +335,132 @@ pub fn parse_solutions(path: &Path, text: &str) -> Result<Vec<AutoSolution>, Aut
         let nrowpr = sized(8, "NROWPR", 1, lines.len() - line)?;
         let ntst = sized(9, "NTST", 0, MAX_POINTS)?;
         let ncol = sized(10, "NCOL", 0, MAX_POINTS)?;
-        let ndim = nar - 1;
-        // the block's numbers, each with its line
-        let mut tokens: Vec<(usize, &str)> = Vec::new();
-        for (k, l) in lines[line..line + nrowpr].iter().enumerate() {
-            tokens.extend(l.split_whitespace().map(|w| (line + 1 + k, w)));
-        }
-        let small = ntpl * nar + npar;
-        let full = small + 2 * nfpr + ndim * ntpl;
-        let direction = if tokens.len() == full && full != small {
-            true
-        } else if tokens.len() == small {
-            false
-        } else {
-            return Err(bad(
-                line,
-                "NROWPR",
-                format!(
-                    "its {nrowpr} lines hold {} numbers; NTPL × NAR + NPAR = {small} (or {full} \
-                     with the direction vector)",
-                    tokens.len()
-                ),
-            ));
-        };
-        let number = |k: usize, what: &dyn Fn() -> String| -> Result<(f64, f64), AutoError> {
-            let (l, w) = tokens[k];
-            fortran_number(w)
-                .ok_or_else(|| bad(l, &what(), format!("`{w}` is not a finite number")))
-        };
-        let mut t = Vec::with_capacity(ntpl);
-        let mut u = Vec::with_capacity(ntpl * ndim);
-        let mut u0_half_units = Vec::with_capacity(ndim);
-        for p in 0..ntpl {
-            t.push(number(p * nar, &|| format!("t of mesh point {}", p + 1))?.0);
-            for c in 0..ndim {
-                let (v, h) = number(p * nar + 1 + c, &|| {
-                    format!("U({}) of mesh point {}", c + 1, p + 1)
-                })?;
-                u.push(v);
-                if p == 0 {
-                    u0_half_units.push(h);
-                }
-            }
-        }
-        let mut j = ntpl * nar;
-        let (mut active, mut parameter_direction) = (Vec::new(), Vec::new());
-        if direction {
-            for k in 0..nfpr {
-                let (l, w) = tokens[j + k];
-                active.push(w.parse::<i64>().map_err(|_| {
-                    bad(
-                        l,
-                        &format!("ICP({})", k + 1),
-                        format!("`{w}` is not an integer"),
-                    )
-                })?);
-            }
-            j += nfpr;
-            for k in 0..nfpr {
-                parameter_direction.push(number(j + k, &|| format!("RLDOT({})", k + 1))?.0);
-            }
-            // the unknowns' direction is read for its numbers' sake only
-            j += nfpr;
-            for k in 0..ndim * ntpl {
-                number(j + k, &|| format!("UDOT({})", k % ndim + 1))?;
-            }
-            j += ndim * ntpl;
-        }
-        let mut par = Vec::with_capacity(npar);
-        let mut par_half_units = Vec::with_capacity(npar);
-        for k in 0..npar {
-            let (v, h) = number(j + k, &|| format!("PAR({})", k + 1))?;
-            par.push(v);
-            par_half_units.push(h);
-        }
-        out.push(AutoSolution {
-            line,
-            branch: header[0],
-            point: header[1],
-            code: header[2],
-            kind: PointType::from_code(header[2]),
-            label: header[3],
-            isw: header[5],
+        Ok(Header {
+            values: header,
+            ntpl,
+            nar,
+            npar,
+            nfpr,
+            nrowpr,
             ntst,
             ncol,
-            ndim,
-            t,
-            u,
-            u0_half_units,
-            active,
-            parameter_direction,
-            par,
-            par_half_units,
-        });
-        if out.len() > crate::io::verify_file::MAX_SOLUTIONS {
-            return Err(bad(
-                line,
-                "LAB",
-                format!(
-                    "more than {} solutions; the most read is that",
-                    crate::io::verify_file::MAX_SOLUTIONS
-                ),
-            ));
-        }
-        i = line + nrowpr;
+        })
     }
-    Ok(out)
+}
+
+/// The solution whose header is line `i` (0-based) of `lines` (the file
+/// `path`), and the index of the line after its block.
+fn solution_at(path: &Path, lines: &[&str], i: usize) -> Result<(AutoSolution, usize), AutoError> {
+    let bad = |line: usize, field: &str, reason: String| AutoError::Format {
+        path: path.into(),
+        line,
+        field: field.into(),
+        reason,
+    };
+    let line = i + 1;
+    let Header {
+        values: header,
+        ntpl,
+        nar,
+        npar,
+        nfpr,
+        nrowpr,
+        ntst,
+        ncol,
+    } = Header::read(lines, line, &bad)?;
+    let ndim = nar - 1;
+    // the block's numbers, each with its line
+    let mut tokens: Vec<(usize, &str)> = Vec::new();
+    for (k, l) in lines[line..line + nrowpr].iter().enumerate() {
+        tokens.extend(l.split_whitespace().map(|w| (line + 1 + k, w)));
+    }
+    let small = ntpl * nar + npar;
+    let full = small + 2 * nfpr + ndim * ntpl;
+    let direction = if tokens.len() == full && full != small {
+        true
+    } else if tokens.len() == small {
+        false
+    } else {
+        return Err(bad(
+            line,
+            "NROWPR",
+            format!(
+                "its {nrowpr} lines hold {} numbers; NTPL × NAR + NPAR = {small} (or {full} \
+                     with the direction vector)",
+                tokens.len()
+            ),
+        ));
+    };
+    let number = |k: usize, what: &dyn Fn() -> String| -> Result<(f64, f64), AutoError> {
+        let (l, w) = tokens[k];
+        fortran_number(w).ok_or_else(|| bad(l, &what(), format!("`{w}` is not a finite number")))
+    };
+    let mut t = Vec::with_capacity(ntpl);
+    let mut u = Vec::with_capacity(ntpl * ndim);
+    let mut u0_half_units = Vec::with_capacity(ndim);
+    for p in 0..ntpl {
+        t.push(number(p * nar, &|| format!("t of mesh point {}", p + 1))?.0);
+        for c in 0..ndim {
+            let (v, h) = number(p * nar + 1 + c, &|| {
+                format!("U({}) of mesh point {}", c + 1, p + 1)
+            })?;
+            u.push(v);
+            if p == 0 {
+                u0_half_units.push(h);
+            }
+        }
+    }
+    let mut j = ntpl * nar;
+    let (mut active, mut parameter_direction) = (Vec::new(), Vec::new());
+    if direction {
+        for k in 0..nfpr {
+            let (l, w) = tokens[j + k];
+            active.push(w.parse::<i64>().map_err(|_| {
+                bad(
+                    l,
+                    &format!("ICP({})", k + 1),
+                    format!("`{w}` is not an integer"),
+                )
+            })?);
+        }
+        j += nfpr;
+        for k in 0..nfpr {
+            parameter_direction.push(number(j + k, &|| format!("RLDOT({})", k + 1))?.0);
+        }
+        // the unknowns' direction is read for its numbers' sake only
+        j += nfpr;
+        for k in 0..ndim * ntpl {
+            number(j + k, &|| format!("UDOT({})", k % ndim + 1))?;
+        }
+        j += ndim * ntpl;
+    }
+    let mut par = Vec::with_capacity(npar);
+    let mut par_half_units = Vec::with_capacity(npar);
+    for k in 0..npar {
+        let (v, h) = number(j + k, &|| format!("PAR({})", k + 1))?;
+        par.push(v);
+        par_half_units.push(h);
+    }
+    let solution = AutoSolution {
+        line,
+        branch: header[0],
+        point: header[1],
+        code: header[2],
+        kind: PointType::from_code(header[2]),
+        label: header[3],
+        isw: header[5],
+        ntst,
+        ncol,
+        ndim,
+        t,
+        u,
+        u0_half_units,
+        active,
+        parameter_direction,
+        par,
+        par_half_units,
+    };
+    Ok((solution, line + nrowpr))
 }
 
 /// An AUTO-07p branch file (`b.NAME`, `fort.7`).

@@ -41,6 +41,14 @@ pub enum PolishError {
         /// Across the other way.
         second: Box<PolishError>,
     },
+    /// A corner failed along both curves.
+    #[error("{first}; along the other curve: {second}")]
+    AlongOther {
+        /// Along the first curve.
+        first: Box<PolishError>,
+        /// Along the other.
+        second: Box<PolishError>,
+    },
     /// A boundary point failed, and again from its nearest polished neighbour.
     #[error("{first}; from the nearest polished point: {second}")]
     FromNeighbour {
@@ -57,6 +65,65 @@ pub enum PolishError {
         /// What.
         source: Box<PolishError>,
     },
+    /// The traced boundary has no pieces.
+    #[error("no boundary to polish")]
+    NoBoundary,
+    /// A walk point carries no discrete equilibrium to start from.
+    #[error("no discrete equilibrium")]
+    NoDiscreteEquilibrium,
+    /// A corner's piece has no polished point to start from.
+    #[error("no polished point")]
+    NoPolishedPoint,
+    /// A crossing of a clamp's closing ray has no continuum test.
+    #[error("a crossing of a clamp's ray is not polished")]
+    ClampRayCrossing,
+    /// A crossing names a segment past the centreline's end.
+    #[error("no segment {0} on the centreline")]
+    NoSegment(usize),
+    /// The root lies too far from its start (another extremum's or branch's).
+    #[error("the root moved {moved:.2e} from its start, more than {reach:.2e}")]
+    Moved {
+        /// How far it moved in the free coordinate.
+        moved: f64,
+        /// How far it may.
+        reach: f64,
+    },
+    /// The rod at the root passes through a wall.
+    #[error("the root at ({:.5}, {:.5}) is not between the walls", at[0], at[1])]
+    OutsideWalls {
+        /// The root in the plane.
+        at: [f64; 2],
+    },
+    /// A corner's secant iteration failed.
+    #[error("the corner's secant steps {0}")]
+    Corner(CornerFailure),
+    /// A corner's secant step would leave the corner.
+    #[error("the corner's secant step {0:.2e} left the corner")]
+    CornerLeft(f64),
+    /// Too many of a boundary's points failed for its area to mean much.
+    #[error("{failed} of {of} points failed, the first: {first}")]
+    TooManyFailed {
+        /// Points that failed.
+        failed: usize,
+        /// Points in all.
+        of: usize,
+        /// The first failure.
+        first: Box<PolishError>,
+    },
+}
+
+/// How a corner's secant iteration failed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum CornerFailure {
+    /// It took its iterations without converging (nor stalling).
+    #[error("did not converge")]
+    NotConverged,
+    /// The test along the curve was flat or undefined.
+    #[error("met a flat or undefined test ({0:.2e})")]
+    Flat(f64),
+    /// A step's root or test failed.
+    #[error("{0}")]
+    Step(Box<PolishError>),
 }
 
 impl From<ContinuumError> for PolishError {

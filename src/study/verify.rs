@@ -15,6 +15,7 @@
 //! results are the same for any thread count.
 
 use crate::analysis::equilibrium::Equilibrium;
+use crate::analysis::event::PolishFailure;
 use crate::geometry::closure::{closure_knot_along, ray_closure};
 use crate::geometry::writhe::writhe_closed;
 use crate::model::rod::{Law, Parameter};
@@ -468,7 +469,7 @@ pub struct FoldCheck {
     /// determinant, from the discrete fold at 4N) and its error.
     pub continuum: Option<(f64, f64)>,
     /// Why the continuum's fold could not be located.
-    pub continuum_failure: Option<String>,
+    pub continuum_failure: Option<PolishFailure>,
 }
 
 /// Everything verify found about one solution.
@@ -989,7 +990,9 @@ fn at_fold(
                 continuum_negative = spectrum.negative.checked_sub(below);
             }
         }
-        None => fold.continuum_failure = Some(event.detail.trim_start_matches("; ").into()),
+        // (the polish says why on the event; its detail is the discrete
+        // rod's text)
+        None => fold.continuum_failure = event.not_polished.clone(),
     }
     let eqs = folds.into_iter().map(|f| f.equilibrium).collect();
     Ok(Found {

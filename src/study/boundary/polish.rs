@@ -12,9 +12,11 @@ use crate::model::rod::{Clamps, Parameter, RodModel, RodState};
 use crate::solve::continuum::branch::{BranchPoint, ContinuumBranch, PARAMETER, TestFunction};
 use crate::study::boundary::condition::{Condition, OtherStrand};
 use crate::study::boundary::traced::{
-    PolishedBoundary, PolishedCorner, Trail, TrailPoint, name_pieces,
+    Piece, PolishedBoundary, PolishedCorner, Trail, TrailPoint, name_pieces,
 };
-use crate::study::polish::{discrete_unknowns, locate_root, singular_at};
+use crate::study::polish::{
+    CornerFailure, PolishError, discrete_unknowns, locate_root, singular_at,
+};
 use rayon::prelude::*;
 
 /// Integrator tolerance of the boundary's polish: its points to about
@@ -66,9 +68,13 @@ impl Plane<'_> {
         at: [f64; 2],
         free: usize,
         tolerance: f64,
-    ) -> Result<ContinuumBranch<'_>, String> {
-        ContinuumBranch::new(self.model, self.clamps(at), self.params[free], tolerance)
-            .map_err(|e| e.to_string())
+    ) -> Result<ContinuumBranch<'_>, PolishError> {
+        Ok(ContinuumBranch::new(
+            self.model,
+            self.clamps(at),
+            self.params[free],
+            tolerance,
+        )?)
     }
 
     /// The continuum test function of condition `c` at the discrete `state`
@@ -81,18 +87,18 @@ impl Plane<'_> {
         z: &BranchPoint,
         state: &RodState,
         c: &Condition,
-    ) -> Result<TestFunction, String> {
+    ) -> Result<TestFunction, PolishError> {
         match c {
             Condition::Wall => Ok(TestFunction::Walls),
-            Condition::Stability => singular_at(branch, z).map_err(|e| e.to_string()),
+            Condition::Stability => singular_at(branch, z),
             Condition::Crossing(s) => {
                 let OtherStrand::Segment(j) = s.other else {
-                    return Err("a crossing of a clamp's ray is not polished".into());
+                    return Err(PolishError::ClampRayCrossing);
                 };
                 let (points, arc) = state.centreline();
                 let i = s.first;
                 if j + 1 >= points.len() {
-                    return Err(format!("no segment {j} on the centreline"));
+                    return Err(PolishError::NoSegment(j));
                 }
                 let (_, ta, tb) = crate::geometry::distance::segment_distance(
                     &points[i],
@@ -126,18 +132,26 @@ impl Plane<'_> {
 
     /// A walk point on its condition, polished on the line through it that
     /// crosses the curve most steeply, else on the other line.
-    fn point(&self, p: &TrailPoint, c: &Condition) -> Result<Polished, String> {
+    fn point(&self, p: &TrailPoint, c: &Condition) -> Result<Polished, PolishError> {
         let free = free_of(p.normal);
         self.point_on(p, c, free).or_else(|first| {
             self.point_on(p, c, 1 - free)
-                .map_err(|second| format!("{first}; across the other way: {second}"))
+                .map_err(|second| PolishError::BothWays {
+                    first: Box::new(first),
+                    second: Box::new(second),
+                })
         })
     }
 
     /// A walk point on its condition, polished on the line through it free
     /// in coordinate `free`.
-    fn point_on(&self, p: &TrailPoint, c: &Condition, free: usize) -> Result<Polished, String> {
-        let state = p.state.as_ref().ok_or("no discrete equilibrium")?;
+    fn point_on(
+        &self,
+        p: &TrailPoint,
+        c: &Condition,
+        free: usize,
+    ) -> Result<Polished, PolishError> {
+        let state = p.state.as_ref().ok_or(PolishError::NoDiscreteEquilibrium)?;
         let (at, z) = self.start(state, free);
         let branch = self.line(at, free, BOUNDARY_TOLERANCE)?;
         let test = self.test_of(&branch, &z, state, c)?;
@@ -157,20 +171,15 @@ impl Plane<'_> {
         test: TestFunction,
         normal: [f64; 2],
         reach: f64,
-    ) -> Result<Polished, String> {
+    ) -> Result<Polished, PolishError> {
         let r = self.root_on(branch, at, free, z, test, normal)?;
         let moved = (r.at[free] - at[free]).abs();
         if moved > reach {
-            return Err(format!(
-                "the root moved {moved:.2e} from its start, more than {reach:.2e}"
-            ));
+            return Err(PolishError::Moved { moved, reach });
         }
         let line = self.line(r.at, free, branch.tolerance)?;
         if !walled(&line, &r.z, WALL_SLACK)? {
-            return Err(format!(
-                "the root at ({:.5}, {:.5}) is not between the walls",
-                r.at[0], r.at[1]
-            ));
+            return Err(PolishError::OutsideWalls { at: r.at });
         }
         Ok(r)
     }
@@ -183,8 +192,8 @@ impl Plane<'_> {
         z: BranchPoint,
         test: TestFunction,
         normal: [f64; 2],
-    ) -> Result<Polished, String> {
-        let root = locate_root(branch, z, PARAMETER, test).map_err(|e| e.to_string())?;
+    ) -> Result<Polished, PolishError> {
+        let root = locate_root(branch, z, PARAMETER, test)?;
         at[free] = root.fine.point[PARAMETER];
         Ok(Polished {
             at,
@@ -205,7 +214,7 @@ impl Plane<'_> {
         free: usize,
         near: &[(&Polished, f64)],
         reach: f64,
-    ) -> Result<Polished, String> {
+    ) -> Result<Polished, PolishError> {
         let branch = self.line(at, free, BOUNDARY_TOLERANCE)?;
         let mut z = near.iter().map(|(p, w)| *w * p.z).sum::<BranchPoint>();
         z[PARAMETER] = at[free];
@@ -217,7 +226,7 @@ impl Plane<'_> {
 
     /// The point of the curve a fraction `w` of the way from `a` to `b`, two
     /// polished neighbours on it.
-    fn between(&self, a: &Polished, b: &Polished, w: f64) -> Result<Polished, String> {
+    fn between(&self, a: &Polished, b: &Polished, w: f64) -> Result<Polished, PolishError> {
         let at = [
             a.at[0] + w * (b.at[0] - a.at[0]),
             a.at[1] + w * (b.at[1] - a.at[1]),
@@ -243,7 +252,7 @@ impl Plane<'_> {
         &self,
         pieces: &[Vec<Polished>],
         parts: impl Fn(&Polished, &Polished) -> usize + Sync,
-    ) -> Result<Vec<Vec<Polished>>, String> {
+    ) -> Result<Vec<Vec<Polished>>, PolishError> {
         let jobs: Vec<(usize, usize, f64)> = pieces
             .iter()
             .enumerate()
@@ -260,10 +269,10 @@ impl Plane<'_> {
             .map(|&(k, i, w)| {
                 let (a, b) = (&pieces[k][i - 1], &pieces[k][i]);
                 self.between(a, b, w).map_err(|e| {
-                    format!(
-                        "between ({:.5}, {:.5}) and ({:.5}, {:.5}): {e}",
+                    e.at(format!(
+                        "between ({:.5}, {:.5}) and ({:.5}, {:.5})",
                         a.at[0], a.at[1], b.at[0], b.at[1]
-                    )
+                    ))
                 })
             })
             .collect::<Result<_, _>>()?;
@@ -299,8 +308,8 @@ impl Plane<'_> {
         p: &TrailPoint,
         test_a: TestFunction,
         test_b: TestFunction,
-    ) -> Result<(Polished, TestFunction), String> {
-        let state = p.state.as_ref().ok_or("no discrete equilibrium")?;
+    ) -> Result<(Polished, TestFunction), PolishError> {
+        let state = p.state.as_ref().ok_or(PolishError::NoDiscreteEquilibrium)?;
         let free = free_of(p.normal);
         let (at, z) = self.start(state, free);
         self.corner_from(at, z, free, p.normal, test_a, test_b)
@@ -316,7 +325,7 @@ impl Plane<'_> {
         normal: [f64; 2],
         test_a: TestFunction,
         test_b: TestFunction,
-    ) -> Result<(Polished, TestFunction), String> {
+    ) -> Result<(Polished, TestFunction), PolishError> {
         let coarse = self.secant_corner(at, free, z, test_a, test_b, BOUNDARY_TOLERANCE, 1e-4)?;
         let fine = self.secant_corner(
             coarse.0.at,
@@ -379,7 +388,7 @@ impl Plane<'_> {
         test_b: TestFunction,
         tolerance: f64,
         step: f64,
-    ) -> Result<(Polished, TestFunction, f64), String> {
+    ) -> Result<(Polished, TestFunction, f64), PolishError> {
         let held = 1 - free;
         // a's root on the line with the held coordinate at `v`, and b there
         let on_a = |v: f64, z: BranchPoint, ta: &TestFunction, tb: &TestFunction| {
@@ -387,21 +396,17 @@ impl Plane<'_> {
             q[held] = v;
             let branch = self.line(q, free, tolerance)?;
             let scale = 1.0 + z[PARAMETER].abs();
-            let located = branch
-                .locate(
-                    z,
-                    PARAMETER,
-                    1e-4 * scale,
-                    0.1 * tolerance * scale,
-                    ta.clone(),
-                )
-                .map_err(|e| e.to_string())?;
-            let (tb, gb) = branch
-                .evaluate(&located.point, tb)
-                .map_err(|e| e.to_string())?;
+            let located = branch.locate(
+                z,
+                PARAMETER,
+                1e-4 * scale,
+                0.1 * tolerance * scale,
+                ta.clone(),
+            )?;
+            let (tb, gb) = branch.evaluate(&located.point, tb)?;
             q[free] = located.point[PARAMETER];
             let error = (located.point[PARAMETER] - located.previous[PARAMETER]).abs();
-            Ok::<_, String>((
+            Ok::<_, PolishError>((
                 Polished {
                     at: q,
                     error,
@@ -420,21 +425,21 @@ impl Plane<'_> {
         let mut visited = vec![pa.at[held], pb.at[held]];
         let why = loop {
             if visited.len() > CORNER_ITERATIONS {
-                break "did not converge".to_string();
+                break CornerFailure::NotConverged;
             }
             if gb == ga || !gb.is_finite() {
-                break format!("met a flat or undefined test ({gb:.2e})");
+                break CornerFailure::Flat(gb);
             }
             let dv = -gb * (pb.at[held] - pa.at[held]) / (gb - ga);
             if dv.abs() > 0.05 {
-                return Err(format!("the corner's secant step {dv:.2e} left the corner"));
+                return Err(PolishError::CornerLeft(dv));
             }
             // predict the unknowns along the chord of the last two points
             let f = dv / (pb.at[held] - pa.at[held]);
             let zc = pb.z + f * (pb.z - pa.z);
             let (pc, t, gc) = match on_a(pb.at[held] + dv, zc, &pb.test.clone(), &tb) {
                 Ok(next) => next,
-                Err(e) => break e,
+                Err(e) => break CornerFailure::Step(Box::new(e)),
             };
             tb = t;
             (pa, ga) = (pb, gb);
@@ -455,7 +460,7 @@ impl Plane<'_> {
                 return Ok((pb, tb, spread));
             }
         }
-        Err(format!("the corner's secant steps {why}"))
+        Err(PolishError::Corner(why))
     }
 }
 
@@ -470,8 +475,8 @@ const STALLED_ITERATES: usize = 4;
 
 /// The continuum solution at z lies between the walls (to `slack`, touching
 /// allowed), at the points of [`ContinuumBranch::heights`].
-fn walled(branch: &ContinuumBranch, z: &BranchPoint, slack: f64) -> Result<bool, String> {
-    let (_, heights) = branch.heights(z).map_err(|e| e.to_string())?;
+fn walled(branch: &ContinuumBranch, z: &BranchPoint, slack: f64) -> Result<bool, PolishError> {
+    let (_, heights) = branch.heights(z)?;
     let top = branch.clamps_at(z[PARAMETER]).top_wall();
     Ok(heights.iter().all(|&h| h >= -slack && h <= top + slack))
 }
@@ -581,320 +586,436 @@ pub(super) fn polish_boundary(
     base: Clamps,
     trail: &[Trail],
     spacing: f64,
-) -> Result<PolishedBoundary, String> {
+) -> Result<PolishedBoundary, PolishError> {
+    if trail.is_empty() {
+        return Err(PolishError::NoBoundary);
+    }
     let plane = Plane {
         model,
         params,
         base,
         spacing,
     };
-    if trail.is_empty() {
-        return Err("no boundary to polish".into());
-    }
-    let last = trail.len() - 1;
-    // the points other than corners (where one piece ends and the next
-    // starts), each on its line from its discrete equilibrium
-    let jobs: Vec<(usize, usize)> = trail
-        .iter()
-        .enumerate()
-        .flat_map(|(k, (_, pts))| {
-            let first = usize::from(k > 0);
-            let end = if k < last { pts.len() - 1 } else { pts.len() };
-            (first..end).map(move |i| (k, i))
-        })
-        .collect();
-    let describe = |k: usize, i: usize, e: String| {
-        let (c, pts) = &trail[k];
-        format!(
-            "{} at ({:.5}, {:.5}): {e}",
-            c.describe(),
-            pts[i].at[0],
-            pts[i].at[1]
-        )
-    };
-    let first: Vec<Result<Polished, String>> = jobs
-        .par_iter()
-        .map(|&(k, i)| plane.point(&trail[k].1[i], &trail[k].0))
-        .collect();
-    // a point that fails from its discrete start (too far from the
-    // continuum at small N) is tried again from its piece's nearest polished
-    // point, on its own line; passes repeat while they rescue points
-    let mut retried = first;
-    let mut from_neighbour: Vec<Option<String>> = vec![None; jobs.len()];
-    for _ in 0..RETRY_PASSES {
-        let again: Vec<(usize, Result<Polished, String>)> = (0..jobs.len())
-            .into_par_iter()
-            .filter(|&n| retried[n].is_err())
-            .filter_map(|n| {
-                let (k, i) = jobs[n];
-                let near = (0..jobs.len())
-                    .filter(|&m| jobs[m].0 == k && retried[m].is_ok())
-                    .min_by_key(|&m| jobs[m].1.abs_diff(i))?;
-                let q = retried[near].as_ref().ok()?;
-                // on the discrete point's line, started at the neighbour's
-                // value (the curve there), so that the reach is measured
-                // from the continuum curve, not from the discrete one
-                let p = &trail[k].1[i];
-                let free = free_of(p.normal);
-                let mut at = p.at;
-                at[free] = q.at[free];
-                let r = plane.near_neighbours(at, free, &[(q, 1.0)], 2.0 * spacing);
-                Some((n, r))
-            })
-            .collect();
-        let mut rescued = 0;
-        for (n, r) in again {
-            match r {
-                Ok(p) => {
-                    retried[n] = Ok(p);
-                    rescued += 1;
-                }
-                Err(e) => from_neighbour[n] = Some(e),
-            }
-        }
-        if rescued == 0 {
-            break;
-        }
-    }
-    for (r, e) in retried.iter_mut().zip(from_neighbour) {
-        if let (Err(first), Some(e)) = (r, e) {
-            *first = format!("{first}; from its piece's nearest polished point: {e}");
-        }
-    }
-    // a point that fails (its discrete start too far from the continuum,
-    // next to a branch point say) is left out, and said so: its
-    // neighbours' middle is polished instead
-    let mut dropped = Vec::new();
-    let (jobs, points): (Vec<(usize, usize)>, Vec<Polished>) = jobs
-        .into_iter()
-        .zip(retried)
-        .filter_map(|((k, i), r)| match r {
-            Ok(p) => Some(((k, i), p)),
-            Err(e) => {
-                dropped.push(describe(k, i, e));
-                None
-            }
-        })
-        .unzip();
-    if dropped.len() * 10 > jobs.len() {
-        return Err(format!(
-            "{} of {} points failed, the first: {}",
-            dropped.len(),
-            jobs.len() + dropped.len(),
-            dropped[0]
-        ));
-    }
+    let (jobs, points, dropped) = plane.walk_points(trail)?;
     let piece_of = pieces_by_critical_point(trail.len(), &jobs, &points);
-    // the corners, with the tests of their pieces' polished points nearest
+    let on = OnPieces {
+        trail,
+        piece_of: &piece_of,
+        points: &points,
+    };
     let corners: Vec<(Polished, Polished)> = (1..trail.len())
         .into_par_iter()
-        .map(|k| {
-            let (a, pa) = &trail[k - 1];
-            let (b, _) = &trail[k];
-            let corner = pa.last().expect("pieces have points");
-            let state = corner.state.as_ref().ok_or("no discrete equilibrium")?;
-            // the piece's polished point nearest the corner
-            let nearest = |piece: usize, from_end: bool| -> Option<&Polished> {
-                let mut mine = piece_of
-                    .iter()
-                    .zip(&points)
-                    .filter(|(k, _)| **k == piece)
-                    .map(|(_, p)| p);
-                if from_end {
-                    mine.next_back()
-                } else {
-                    mine.next()
-                }
-            };
-            // the test of the piece's nearest polished point (a singular
-            // test's borders at a continuum root), else the discrete corner's
-            let test = |piece: usize, from_end: bool| -> Result<TestFunction, String> {
-                match nearest(piece, from_end) {
-                    Some(p) => Ok(p.test.clone()),
-                    None => {
-                        let free = free_of(corner.normal);
-                        let (at, z) = plane.start(state, free);
-                        let branch = plane.line(at, free, BOUNDARY_TOLERANCE)?;
-                        plane.test_of(&branch, &z, state, &trail[piece].0)
-                    }
-                }
-            };
-            let (ta, tb) = (test(k - 1, true)?, test(k, false)?);
-            // each side of the corner keeps its own piece's test and normal
-            let from_b = &trail[k].1[0];
-            let with = |p: &Polished, test: TestFunction, normal: [f64; 2]| Polished {
-                test,
-                normal,
-                ..p.clone()
-            };
-            // two crossings that run into one: the corner is where their
-            // closest points merge, on the critical point that persists
-            let merger = match (nearest(k - 1, true), nearest(k, false)) {
-                (Some(pa), Some(pb)) => plane.merger(pa, pb).map(|m| (m, pa, pb)),
-                _ => None,
-            };
-            // along both curves: two routes to one corner, whose difference
-            // joins its error estimate
-            let (along_a, along_b) = if let Some((m, pa, pb)) = merger {
-                let crossing = |m: &TestFunction| match m {
-                    TestFunction::Merging { s } => TestFunction::Crossing { s: *s },
-                    other => other.clone(),
-                };
-                (
-                    plane
-                        .corner_from(pa.at, pa.z, pa.free, pa.normal, ta, m.clone())
-                        .map(|(c, m)| (c.clone(), with(&c, crossing(&m), pb.normal))),
-                    plane
-                        .corner_from(pb.at, pb.z, pb.free, pb.normal, tb, m)
-                        .map(|(c, m)| (with(&c, crossing(&m), pa.normal), c)),
-                )
-            } else {
-                // from the discrete corner, else (at small N, far from the
-                // continuum's) from the piece's polished point nearest it
-                let from_polished = |p: Option<&Polished>, ta: &TestFunction, tb: &TestFunction| {
-                    p.ok_or_else(|| "no polished point".to_string())
-                        .and_then(|p| {
-                            plane.corner_from(p.at, p.z, p.free, p.normal, ta.clone(), tb.clone())
-                        })
-                };
-                (
-                    plane
-                        .corner(corner, ta.clone(), tb.clone())
-                        .or_else(|e| {
-                            from_polished(nearest(k - 1, true), &ta, &tb)
-                                .map_err(|f| format!("{e}; from the nearest polished point: {f}"))
-                        })
-                        .map(|(c, tb)| (c.clone(), with(&c, tb, from_b.normal))),
-                    plane
-                        .corner(from_b, tb.clone(), ta.clone())
-                        .or_else(|e| {
-                            from_polished(nearest(k, false), &tb, &ta)
-                                .map_err(|f| format!("{e}; from the nearest polished point: {f}"))
-                        })
-                        .map(|(c, ta)| (with(&c, ta, corner.normal), c)),
-                )
-            };
-            let (ca, cb) = match (along_a, along_b) {
-                (Ok((mut ca, mut cb)), Ok((other, _))) => {
-                    let apart = (0..2)
-                        .map(|k| (ca.at[k] - other.at[k]).abs())
-                        .fold(other.error, f64::max);
-                    ca.error = ca.error.max(apart);
-                    cb.error = ca.error;
-                    (ca, cb)
-                }
-                (Ok(c), Err(_)) | (Err(_), Ok(c)) => c,
-                (Err(first), Err(second)) => {
-                    return Err(format!(
-                        "corner of {} and {}: {first}; along the other curve: {second}",
-                        a.describe(),
-                        b.describe()
-                    ));
-                }
-            };
-            let line = plane.line(ca.at, ca.free, BOUNDARY_TOLERANCE)?;
-            if !walled(&line, &ca.z, WALL_SLACK)? {
-                return Err(format!(
-                    "corner of {} and {}: at ({:.5}, {:.5}) the rod is not between the walls",
-                    a.describe(),
-                    b.describe(),
-                    ca.at[0],
-                    ca.at[1]
-                ));
-            }
-            Ok((ca, cb))
-        })
+        .map(|k| plane.corner_of(&on, k))
         .collect::<Result<_, _>>()?;
     let largest_shift = jobs
         .iter()
         .zip(&points)
         .map(|(&(k, i), p)| (trail[k].1[i].at[p.free] - p.at[p.free]).abs())
         .fold(0.0, f64::max);
-    // the pieces on the continuum: corners at their ends, points in between
-    // (a point the polish moved past a corner dropped)
-    let mut pieces: Vec<Vec<Polished>> = Vec::new();
-    for (k, (_, pts)) in trail.iter().enumerate() {
-        let mut piece = Vec::new();
-        if k > 0 {
-            piece.push(corners[k - 1].1.clone());
-        }
-        piece.extend(
-            piece_of
-                .iter()
-                .zip(&points)
-                .filter(|(j, _)| **j == k)
-                .map(|(_, p)| p.clone()),
-        );
-        if k + 1 < trail.len() {
-            piece.push(corners[k].0.clone());
-        }
-        // the discrete curve's direction at the piece's ends, from the walk
-        // points that stay on it
-        // (else the whole discrete piece's; with fewer than two points
-        // nothing is trimmed)
-        let mut mine: Vec<[f64; 2]> = piece_of
-            .iter()
-            .zip(&jobs)
-            .filter(|(p, _)| **p == k)
-            .map(|(_, &(kk, i))| trail[kk].1[i].at)
-            .collect();
-        if mine.len() < 2 {
-            mine = pts.iter().map(|p| p.at).collect();
-        }
-        let n = mine.len();
-        if n >= 2 {
-            let ends = [[mine[0], mine[1]], [mine[n - 2], mine[n - 1]]];
-            trim_past_corners(&mut piece, ends, k > 0, k + 1 < trail.len());
-        }
-        pieces.push(piece);
-    }
+    let pieces = on.assemble(&jobs, &corners);
     // gaps wider than the walk's step (where the polish moved a corner
     // past the discrete piece's end) filled, then a point between each pair
     // of neighbours
     let length = |a: &Polished, b: &Polished| (b.at[0] - a.at[0]).hypot(b.at[1] - a.at[1]);
     let filled = plane
         .subdivide(&pieces, |a, b| (length(a, b) / spacing).ceil() as usize)
-        .map_err(|e| format!("filling the pieces: {e}"))?;
+        .map_err(|e| e.at("filling the pieces"))?;
     let refined = plane
         .subdivide(&filled, |_, _| 2)
-        .map_err(|e| format!("between two points: {e}"))?;
-    // areas of nested polygons: all points (h), and without the middles (2h)
-    let polygon = |stride: usize| -> Vec<[f64; 2]> {
-        refined
+        .map_err(|e| e.at("between two points"))?;
+    let area = Area::of(&refined);
+    let (pieces, corners) = named(params, trail, &refined, &corners);
+    Ok(PolishedBoundary {
+        pieces,
+        corners,
+        area: area.extrapolated,
+        area_error: area.error,
+        area_polygon: area.polygon,
+        largest_point_error: area.largest_point_error,
+        largest_shift,
+        tolerance: BOUNDARY_TOLERANCE,
+        dropped,
+    })
+}
+
+/// The walk's polished points and the pieces they lie on.
+struct OnPieces<'a> {
+    trail: &'a [Trail],
+    /// The piece of each polished point.
+    piece_of: &'a [usize],
+    points: &'a [Polished],
+}
+
+impl OnPieces<'_> {
+    /// The polished point of `piece` nearest its end (`from_end`) or start.
+    fn nearest(&self, piece: usize, from_end: bool) -> Option<&Polished> {
+        let mut mine = self
+            .piece_of
             .iter()
-            .flat_map(|p| {
-                let at: Vec<[f64; 2]> = p.iter().map(|q| q.at).collect();
-                let mut t = thinned(&at, stride);
-                t.pop();
-                t
+            .zip(self.points)
+            .filter(|(k, _)| **k == piece)
+            .map(|(_, p)| p);
+        if from_end {
+            mine.next_back()
+        } else {
+            mine.next()
+        }
+    }
+
+    /// The pieces on the continuum: corners at their ends, points in
+    /// between (a point the polish moved past a corner dropped); `jobs`:
+    /// each point's walk piece and index.
+    fn assemble(
+        &self,
+        jobs: &[(usize, usize)],
+        corners: &[(Polished, Polished)],
+    ) -> Vec<Vec<Polished>> {
+        let trail = self.trail;
+        let mut pieces: Vec<Vec<Polished>> = Vec::new();
+        for (k, (_, pts)) in trail.iter().enumerate() {
+            let mut piece = Vec::new();
+            if k > 0 {
+                piece.push(corners[k - 1].1.clone());
+            }
+            piece.extend(
+                self.piece_of
+                    .iter()
+                    .zip(self.points)
+                    .filter(|(j, _)| **j == k)
+                    .map(|(_, p)| p.clone()),
+            );
+            if k + 1 < trail.len() {
+                piece.push(corners[k].0.clone());
+            }
+            // the discrete curve's direction at the piece's ends, from the walk
+            // points that stay on it
+            // (else the whole discrete piece's; with fewer than two points
+            // nothing is trimmed)
+            let mut mine: Vec<[f64; 2]> = self
+                .piece_of
+                .iter()
+                .zip(jobs)
+                .filter(|(p, _)| **p == k)
+                .map(|(_, &(kk, i))| trail[kk].1[i].at)
+                .collect();
+            if mine.len() < 2 {
+                mine = pts.iter().map(|p| p.at).collect();
+            }
+            let n = mine.len();
+            if n >= 2 {
+                let ends = [[mine[0], mine[1]], [mine[n - 2], mine[n - 1]]];
+                trim_past_corners(&mut piece, ends, k > 0, k + 1 < trail.len());
+            }
+            pieces.push(piece);
+        }
+        pieces
+    }
+}
+
+/// The walk's points (other than corners) polished, each with its walk
+/// piece and index; a point that fails is left out, and said so (why, as
+/// text for the map's file), unless more than a tenth fail.
+type WalkPoints = (Vec<(usize, usize)>, Vec<Polished>, Vec<String>);
+
+impl Plane<'_> {
+    /// The points other than corners (where one piece ends and the next
+    /// starts), each on its line from its discrete equilibrium, else from
+    /// its piece's nearest polished point.
+    fn walk_points(&self, trail: &[Trail]) -> Result<WalkPoints, PolishError> {
+        let last = trail.len() - 1;
+        let jobs: Vec<(usize, usize)> = trail
+            .iter()
+            .enumerate()
+            .flat_map(|(k, (_, pts))| {
+                let first = usize::from(k > 0);
+                let end = if k < last { pts.len() - 1 } else { pts.len() };
+                (first..end).map(move |i| (k, i))
+            })
+            .collect();
+        let first: Vec<Result<Polished, PolishError>> = jobs
+            .par_iter()
+            .map(|&(k, i)| self.point(&trail[k].1[i], &trail[k].0))
+            .collect();
+        let retried = self.retried(trail, &jobs, first);
+        // a point that fails (its discrete start too far from the continuum,
+        // next to a branch point say) is left out, and said so: its
+        // neighbours' middle is polished instead
+        let mut dropped = Vec::new();
+        let (jobs, points): (Vec<(usize, usize)>, Vec<Polished>) = jobs
+            .into_iter()
+            .zip(retried)
+            .filter_map(|((k, i), r)| match r {
+                Ok(p) => Some(((k, i), p)),
+                Err(e) => {
+                    let (c, pts) = &trail[k];
+                    dropped.push(e.at(format!(
+                        "{} at ({:.5}, {:.5})",
+                        c.describe(),
+                        pts[i].at[0],
+                        pts[i].at[1]
+                    )));
+                    None
+                }
+            })
+            .unzip();
+        if dropped.len() * 10 > jobs.len() {
+            let failed = dropped.len();
+            return Err(PolishError::TooManyFailed {
+                failed,
+                of: jobs.len() + failed,
+                first: Box::new(dropped.swap_remove(0)),
+            });
+        }
+        let dropped = dropped.iter().map(ToString::to_string).collect();
+        Ok((jobs, points, dropped))
+    }
+
+    /// The points that failed from their discrete start (too far from the
+    /// continuum at small N) tried again from their piece's nearest
+    /// polished point, on their own line; passes repeat while they rescue
+    /// points.
+    fn retried(
+        &self,
+        trail: &[Trail],
+        jobs: &[(usize, usize)],
+        mut retried: Vec<Result<Polished, PolishError>>,
+    ) -> Vec<Result<Polished, PolishError>> {
+        let mut from_neighbour: Vec<Option<PolishError>> = (0..jobs.len()).map(|_| None).collect();
+        for _ in 0..RETRY_PASSES {
+            let again: Vec<(usize, Result<Polished, PolishError>)> = (0..jobs.len())
+                .into_par_iter()
+                .filter(|&n| retried[n].is_err())
+                .filter_map(|n| {
+                    let (k, i) = jobs[n];
+                    let near = (0..jobs.len())
+                        .filter(|&m| jobs[m].0 == k && retried[m].is_ok())
+                        .min_by_key(|&m| jobs[m].1.abs_diff(i))?;
+                    let q = retried[near].as_ref().ok()?;
+                    // on the discrete point's line, started at the neighbour's
+                    // value (the curve there), so that the reach is measured
+                    // from the continuum curve, not from the discrete one
+                    let p = &trail[k].1[i];
+                    let free = free_of(p.normal);
+                    let mut at = p.at;
+                    at[free] = q.at[free];
+                    let r = self.near_neighbours(at, free, &[(q, 1.0)], 2.0 * self.spacing);
+                    Some((n, r))
+                })
+                .collect();
+            let mut rescued = 0;
+            for (n, r) in again {
+                match r {
+                    Ok(p) => {
+                        retried[n] = Ok(p);
+                        rescued += 1;
+                    }
+                    Err(e) => from_neighbour[n] = Some(e),
+                }
+            }
+            if rescued == 0 {
+                break;
+            }
+        }
+        retried
+            .into_iter()
+            .zip(from_neighbour)
+            .map(|(r, e)| match (r, e) {
+                (Err(first), Some(second)) => Err(PolishError::FromNeighbour {
+                    first: Box::new(first),
+                    second: Box::new(second),
+                }),
+                (r, _) => r,
             })
             .collect()
-    };
-    let (a1, a2) = (shoelace(&polygon(1)), shoelace(&polygon(2)));
-    let r1 = a1 + (a1 - a2) / 3.0;
-    let all: Vec<&Polished> = refined.iter().flatten().collect();
-    let largest_point_error = all.iter().map(|p| p.error).fold(0.0, f64::max);
-    // each point's error moves the boundary across half of each chord
-    // beside it
-    let ring: Vec<&Polished> = refined
-        .iter()
-        .flat_map(|p| p[..p.len() - 1].iter())
-        .collect();
-    let n = ring.len();
-    let chord = |i: usize| {
-        let (a, b) = (ring[i].at, ring[(i + 1) % n].at);
-        (b[0] - a[0]).hypot(b[1] - a[1])
-    };
-    let points_error: f64 = (0..n)
-        .map(|i| ring[i].error * 0.5 * (chord((i + n - 1) % n) + chord(i)))
-        .sum();
-    // the Richardson correction is the finest polygon's estimated error,
-    // which bounds the extrapolated area's (an order smaller)
-    let area_error = (r1 - a1).abs() + points_error;
-    // named as the discrete walk's pieces
+    }
+
+    /// The corner between pieces `k - 1` and `k`, located along both
+    /// curves (their difference joins its error estimate) from the tests of
+    /// their polished points nearest it; each side keeps its own piece's
+    /// test and normal.
+    fn corner_of(&self, on: &OnPieces, k: usize) -> Result<(Polished, Polished), PolishError> {
+        let trail = on.trail;
+        let (a, pa) = &trail[k - 1];
+        let (b, _) = &trail[k];
+        let corner = pa.last().expect("pieces have points");
+        let state = corner
+            .state
+            .as_ref()
+            .ok_or(PolishError::NoDiscreteEquilibrium)?;
+        // the test of the piece's nearest polished point (a singular
+        // test's borders at a continuum root), else the discrete corner's
+        let test = |piece: usize, from_end: bool| -> Result<TestFunction, PolishError> {
+            match on.nearest(piece, from_end) {
+                Some(p) => Ok(p.test.clone()),
+                None => {
+                    let free = free_of(corner.normal);
+                    let (at, z) = self.start(state, free);
+                    let branch = self.line(at, free, BOUNDARY_TOLERANCE)?;
+                    self.test_of(&branch, &z, state, &trail[piece].0)
+                }
+            }
+        };
+        let (ta, tb) = (test(k - 1, true)?, test(k, false)?);
+        let between = || format!("corner of {} and {}", a.describe(), b.describe());
+        let (along_a, along_b) = self.corner_routes(on, k, ta, tb);
+        let (ca, cb) = match (along_a, along_b) {
+            (Ok((mut ca, mut cb)), Ok((other, _))) => {
+                let apart = (0..2)
+                    .map(|k| (ca.at[k] - other.at[k]).abs())
+                    .fold(other.error, f64::max);
+                ca.error = ca.error.max(apart);
+                cb.error = ca.error;
+                (ca, cb)
+            }
+            (Ok(c), Err(_)) | (Err(_), Ok(c)) => c,
+            (Err(first), Err(second)) => {
+                return Err(PolishError::At {
+                    at: between(),
+                    source: Box::new(PolishError::AlongOther {
+                        first: Box::new(first),
+                        second: Box::new(second),
+                    }),
+                });
+            }
+        };
+        let line = self.line(ca.at, ca.free, BOUNDARY_TOLERANCE)?;
+        if !walled(&line, &ca.z, WALL_SLACK)? {
+            return Err(PolishError::OutsideWalls { at: ca.at }.at(between()));
+        }
+        Ok((ca, cb))
+    }
+
+    /// The corner between pieces `k - 1` (test `ta`) and `k` (test `tb`)
+    /// along each of the two curves: of two crossings that run into one,
+    /// where their closest points merge, on the critical point that
+    /// persists; else from the discrete corner, or (at small N, far from
+    /// the continuum's) from the piece's polished point nearest it.
+    #[allow(clippy::type_complexity)]
+    fn corner_routes(
+        &self,
+        on: &OnPieces,
+        k: usize,
+        ta: TestFunction,
+        tb: TestFunction,
+    ) -> (
+        Result<(Polished, Polished), PolishError>,
+        Result<(Polished, Polished), PolishError>,
+    ) {
+        let corner = on.trail[k - 1].1.last().expect("pieces have points");
+        let from_b = &on.trail[k].1[0];
+        let with = |p: &Polished, test: TestFunction, normal: [f64; 2]| Polished {
+            test,
+            normal,
+            ..p.clone()
+        };
+        let (near_a, near_b) = (on.nearest(k - 1, true), on.nearest(k, false));
+        let merger = match (near_a, near_b) {
+            (Some(pa), Some(pb)) => self.merger(pa, pb).map(|m| (m, pa, pb)),
+            _ => None,
+        };
+        if let Some((m, pa, pb)) = merger {
+            let crossing = |m: &TestFunction| match m {
+                TestFunction::Merging { s } => TestFunction::Crossing { s: *s },
+                other => other.clone(),
+            };
+            return (
+                self.corner_from(pa.at, pa.z, pa.free, pa.normal, ta, m.clone())
+                    .map(|(c, m)| (c.clone(), with(&c, crossing(&m), pb.normal))),
+                self.corner_from(pb.at, pb.z, pb.free, pb.normal, tb, m)
+                    .map(|(c, m)| (with(&c, crossing(&m), pa.normal), c)),
+            );
+        }
+        let from_polished = |p: Option<&Polished>, ta: &TestFunction, tb: &TestFunction| {
+            p.ok_or(PolishError::NoPolishedPoint)
+                .and_then(|p| self.corner_from(p.at, p.z, p.free, p.normal, ta.clone(), tb.clone()))
+        };
+        let retried = |first: PolishError, second: PolishError| PolishError::FromNeighbour {
+            first: Box::new(first),
+            second: Box::new(second),
+        };
+        (
+            self.corner(corner, ta.clone(), tb.clone())
+                .or_else(|e| from_polished(near_a, &ta, &tb).map_err(|f| retried(e, f)))
+                .map(|(c, tb)| (c.clone(), with(&c, tb, from_b.normal))),
+            self.corner(from_b, tb.clone(), ta.clone())
+                .or_else(|e| from_polished(near_b, &tb, &ta).map_err(|f| retried(e, f)))
+                .map(|(c, ta)| (with(&c, ta, corner.normal), c)),
+        )
+    }
+}
+
+/// The area of a polished boundary and its error.
+struct Area {
+    /// Richardson-extrapolated from the polygons of all points and of every
+    /// other one.
+    extrapolated: f64,
+    /// Its error estimate.
+    error: f64,
+    /// The shoelace area of all the points.
+    polygon: f64,
+    /// Largest error estimate of a point.
+    largest_point_error: f64,
+}
+
+impl Area {
+    /// The area within the closed chain of `refined` pieces (each ending
+    /// where the next starts).
+    fn of(refined: &[Vec<Polished>]) -> Area {
+        // areas of nested polygons: all points (h), and without the middles (2h)
+        let polygon = |stride: usize| -> Vec<[f64; 2]> {
+            refined
+                .iter()
+                .flat_map(|p| {
+                    let at: Vec<[f64; 2]> = p.iter().map(|q| q.at).collect();
+                    let mut t = thinned(&at, stride);
+                    t.pop();
+                    t
+                })
+                .collect()
+        };
+        let (a1, a2) = (shoelace(&polygon(1)), shoelace(&polygon(2)));
+        let r1 = a1 + (a1 - a2) / 3.0;
+        let largest_point_error = refined
+            .iter()
+            .flatten()
+            .map(|p| p.error)
+            .fold(0.0, f64::max);
+        // each point's error moves the boundary across half of each chord
+        // beside it
+        let ring: Vec<&Polished> = refined
+            .iter()
+            .flat_map(|p| p[..p.len() - 1].iter())
+            .collect();
+        let n = ring.len();
+        let chord = |i: usize| {
+            let (a, b) = (ring[i].at, ring[(i + 1) % n].at);
+            (b[0] - a[0]).hypot(b[1] - a[1])
+        };
+        let points_error: f64 = (0..n)
+            .map(|i| ring[i].error * 0.5 * (chord((i + n - 1) % n) + chord(i)))
+            .sum();
+        // the Richardson correction is the finest polygon's estimated error,
+        // which bounds the extrapolated area's (an order smaller)
+        Area {
+            extrapolated: r1,
+            error: (r1 - a1).abs() + points_error,
+            polygon: a1,
+            largest_point_error,
+        }
+    }
+}
+
+/// The polished pieces named as the discrete walk's, and the corners
+/// between them (beside the walk's).
+fn named(
+    params: [Parameter; 2],
+    trail: &[Trail],
+    refined: &[Vec<Polished>],
+    corners: &[(Polished, Polished)],
+) -> (Vec<Piece>, Vec<PolishedCorner>) {
     let trail_polished: Vec<Trail> = trail
         .iter()
-        .zip(&refined)
+        .zip(refined)
         .map(|((c, _), p)| {
             let pts = p
                 .iter()
@@ -926,17 +1047,7 @@ pub(super) fn polish_boundary(
             discrete: trail[k].1.last().expect("pieces have points").at,
         })
         .collect();
-    Ok(PolishedBoundary {
-        pieces: named.pieces,
-        corners,
-        area: r1,
-        area_error,
-        area_polygon: a1,
-        largest_point_error,
-        largest_shift,
-        tolerance: BOUNDARY_TOLERANCE,
-        dropped,
-    })
+    (named.pieces, corners)
 }
 
 /// Drop the interior points of a polished piece that the polish moved past
