@@ -292,8 +292,7 @@ impl Header {
         line: usize,
         bad: &dyn Fn(usize, &str, String) -> AutoError,
     ) -> Result<Header, AutoError> {
-        let i = line - 1;
-        let header: Vec<i64> = lines[i]
+        let header: Vec<i64> = lines[line - 1]
             .split_whitespace()
             .map(|w| w.parse::<i64>())
             .collect::<Result<_, _>>()
@@ -328,22 +327,16 @@ impl Header {
             }
             Ok(v as usize)
         };
-        let ntpl = sized(6, "NTPL", 1, MAX_POINTS)?;
-        let nar = sized(7, "NAR", 2, MAX_DIM + 1)?;
         let npar = sized(11, "NPAR", 1, MAX_PAR)?;
-        let nfpr = sized(4, "NFPR", 0, npar)?;
-        let nrowpr = sized(8, "NROWPR", 1, lines.len() - line)?;
-        let ntst = sized(9, "NTST", 0, MAX_POINTS)?;
-        let ncol = sized(10, "NCOL", 0, MAX_POINTS)?;
         Ok(Header {
-            values: header,
-            ntpl,
-            nar,
+            ntpl: sized(6, "NTPL", 1, MAX_POINTS)?,
+            nar: sized(7, "NAR", 2, MAX_DIM + 1)?,
             npar,
-            nfpr,
-            nrowpr,
-            ntst,
-            ncol,
+            nfpr: sized(4, "NFPR", 0, npar)?,
+            nrowpr: sized(8, "NROWPR", 1, lines.len() - line)?,
+            ntst: sized(9, "NTST", 0, MAX_POINTS)?,
+            ncol: sized(10, "NCOL", 0, MAX_POINTS)?,
+            values: header,
         })
     }
 }
