@@ -416,157 +416,208 @@ fn solution(
     fields: Vec<(String, Raw)>,
     law: Law,
 ) -> Result<Solution, VerifyFileError> {
-    let strip = matches!(law, Law::Strip { .. });
-    let bad = |field: &str, reason: String| VerifyFileError::Field {
-        path: path.into(),
-        row: row.into(),
-        field: field.into(),
-        reason,
+    let mut reader = RowReader {
+        path,
+        row,
+        law,
+        strip: matches!(law, Law::Strip { .. }),
+        name: format!("row {}", index + 1),
+        parameters: Vec::new(),
+        parameter_rounding: Vec::new(),
+        unknowns: [None; 6],
+        set_by: [None; 6],
+        claims: Claims::default(),
     };
-    let mut name = format!("row {}", index + 1);
-    let mut parameters: Vec<(Parameter, f64)> = Vec::new();
-    let mut parameter_rounding: Vec<f64> = Vec::new();
-    let mut unknowns: [Option<(f64, f64)>; 6] = [None; 6];
-    // the field that set each unknown: one given twice (n0 and n0_1) is refused
-    let mut set_by: [Option<&str>; 6] = [None; 6];
-    let mut claims = Claims::default();
-    let finite = |field: &str, raw: &Raw| -> Result<(f64, f64), VerifyFileError> {
+    for (k, (field, raw)) in fields.iter().enumerate() {
+        if fields[..k].iter().any(|(g, _)| g == field) {
+            return Err(reader.bad(field, "given twice".into()));
+        }
+        reader.read(field, raw)?;
+    }
+    reader.finish()
+}
+
+/// One row's fields as they are read: the unknowns, parameters and claims so far.
+struct RowReader<'a> {
+    path: &'a Path,
+    row: &'a str,
+    law: Law,
+    strip: bool,
+    name: String,
+    parameters: Vec<(Parameter, f64)>,
+    parameter_rounding: Vec<f64>,
+    /// n0 then m0 (rod) or u1_0, m2_0, u3_0 (strip), each with its rounding.
+    unknowns: [Option<(f64, f64)>; 6],
+    /// The field that set each unknown: one given twice (n0 and n0_1) is refused.
+    set_by: [Option<&'a str>; 6],
+    claims: Claims,
+}
+
+impl<'a> RowReader<'a> {
+    fn bad(&self, field: &str, reason: String) -> VerifyFileError {
+        VerifyFileError::Field {
+            path: self.path.into(),
+            row: self.row.into(),
+            field: field.into(),
+            reason,
+        }
+    }
+
+    fn finite(&self, field: &str, raw: &Raw) -> Result<(f64, f64), VerifyFileError> {
         match raw {
             Raw::Number(x, u) => usable(*x, *u)
                 .map(|()| (*x, *u))
-                .map_err(|why| bad(field, why)),
-            _ => Err(bad(field, "a finite number".into())),
+                .map_err(|why| self.bad(field, why)),
+            _ => Err(self.bad(field, "a finite number".into())),
         }
-    };
-    let printed = |field: &str, raw: &Raw| -> Result<Printed, VerifyFileError> {
-        let (value, half_unit) = finite(field, raw)?;
-        Ok(Printed { value, half_unit })
-    };
-    let flag = |field: &str, raw: &Raw| -> Result<bool, VerifyFileError> {
+    }
+
+    fn printed(&self, field: &str, raw: &Raw) -> Result<Option<Printed>, VerifyFileError> {
+        let (value, half_unit) = self.finite(field, raw)?;
+        Ok(Some(Printed { value, half_unit }))
+    }
+
+    fn flag(&self, field: &str, raw: &Raw) -> Result<Option<bool>, VerifyFileError> {
         match raw {
-            Raw::Bool(b) => Ok(*b),
-            _ => Err(bad(field, "true or false".into())),
+            Raw::Bool(b) => Ok(Some(*b)),
+            _ => Err(self.bad(field, "true or false".into())),
         }
-    };
-    // the unknowns' slots: n0 then m0 (rod) or u1_0, m2_0, u3_0 (strip)
-    let slots: &[(&str, usize)] = if strip {
-        &[("u1_0", 3), ("m2_0", 4), ("u3_0", 5)]
-    } else {
-        &[]
-    };
-    for (k, (field, raw)) in fields.iter().enumerate() {
-        let f = field.as_str();
-        if fields[..k].iter().any(|(g, _)| g == f) {
-            return Err(bad(f, "given twice".into()));
+    }
+
+    fn set(
+        &mut self,
+        field: &'a str,
+        slot: usize,
+        value: (f64, f64),
+    ) -> Result<(), VerifyFileError> {
+        if let Some(other) = self.set_by[slot].replace(field) {
+            return Err(self.bad(
+                field,
+                format!("the unknown is given twice (by {other} and {field})"),
+            ));
         }
-        let mut set = |slot: usize, value: (f64, f64)| -> Result<(), VerifyFileError> {
-            if let Some(other) = set_by[slot].replace(f) {
-                return Err(bad(
-                    f,
-                    format!("the unknown is given twice (by {other} and {f})"),
-                ));
-            }
-            unknowns[slot] = Some(value);
-            Ok(())
-        };
-        let vector =
-            |base: usize, set: &mut dyn FnMut(usize, (f64, f64)) -> Result<(), VerifyFileError>| {
-                match raw {
-                    Raw::List(v) if v.len() == 3 => {
-                        for (c, &(x, u)) in v.iter().enumerate() {
-                            usable(x, u)
-                                .map_err(|why| bad(f, format!("component {}: {why}", c + 1)))?;
-                            set(base + c, (x, u))?;
-                        }
-                        Ok(())
-                    }
-                    _ => Err(bad(f, "three finite numbers [x, y, z]".into())),
+        self.unknowns[slot] = Some(value);
+        Ok(())
+    }
+
+    /// A vector unknown [x, y, z] into the slots from `base`.
+    fn vector(&mut self, field: &'a str, raw: &Raw, base: usize) -> Result<(), VerifyFileError> {
+        match raw {
+            Raw::List(v) if v.len() == 3 => {
+                for (c, &(x, u)) in v.iter().enumerate() {
+                    usable(x, u)
+                        .map_err(|why| self.bad(field, format!("component {}: {why}", c + 1)))?;
+                    self.set(field, base + c, (x, u))?;
                 }
-            };
-        match f {
+                Ok(())
+            }
+            _ => Err(self.bad(field, "three finite numbers [x, y, z]".into())),
+        }
+    }
+
+    fn read(&mut self, field: &'a str, raw: &Raw) -> Result<(), VerifyFileError> {
+        // the component's index in n0_k / m0_k
+        let component = || field.as_bytes()[3] as usize - b'1' as usize;
+        match field {
             "name" => match raw {
-                Raw::Text(t) => name = t.clone(),
-                Raw::Number(x, _) => name = format!("{x}"),
-                _ => return Err(bad(f, "a name".into())),
+                Raw::Text(t) => self.name = t.clone(),
+                Raw::Number(x, _) => self.name = format!("{x}"),
+                _ => return Err(self.bad(field, "a name".into())),
             },
-            "n0" => vector(0, &mut set)?,
-            "m0" if !strip => vector(3, &mut set)?,
+            "n0" => self.vector(field, raw, 0)?,
+            "m0" if !self.strip => self.vector(field, raw, 3)?,
             "m0" => {
-                return Err(bad(
-                    f,
+                return Err(self.bad(
+                    field,
                     "the scene is a strip: give its unknowns u1_0, m2_0, u3_0 with n0".into(),
                 ));
             }
             "n0_1" | "n0_2" | "n0_3" => {
-                set(f.as_bytes()[3] as usize - b'1' as usize, finite(f, raw)?)?
+                let value = self.finite(field, raw)?;
+                self.set(field, component(), value)?
             }
-            "m0_1" | "m0_2" | "m0_3" if !strip => set(
-                3 + f.as_bytes()[3] as usize - b'1' as usize,
-                finite(f, raw)?,
-            )?,
-            "u1_0" | "m2_0" | "u3_0" if !strip => {
-                return Err(bad(
-                    f,
+            "m0_1" | "m0_2" | "m0_3" if !self.strip => {
+                let value = self.finite(field, raw)?;
+                self.set(field, 3 + component(), value)?
+            }
+            "u1_0" | "m2_0" | "u3_0" if !self.strip => {
+                return Err(self.bad(
+                    field,
                     "the scene is a rod: give its unknowns n0 and m0 (material frame at s = 0)"
                         .into(),
                 ));
             }
-            "stable" => claims.stable = Some(flag(f, raw)?),
-            "walled" => claims.walled = Some(flag(f, raw)?),
-            "lowest_omega2" => claims.lowest_omega2 = Some(printed(f, raw)?),
-            "twist" => claims.twist = Some(printed(f, raw)?),
-            "link" => claims.link = Some(printed(f, raw)?),
-            "energy" => claims.energy = Some(printed(f, raw)?),
-            "knot" => match raw {
-                Raw::Text(t) => claims.knot = Some(t.clone()),
-                _ => return Err(bad(f, "a knot name such as \"3_1\" or \"0_1\"".into())),
-            },
-            _ => {
-                if let Some(&(_, slot)) = slots.iter().find(|(n, _)| *n == f) {
-                    set(slot, finite(f, raw)?)?;
-                } else if let Some(p) = Parameter::named(f) {
-                    if let Some(why) = absent_from(p, law) {
-                        return Err(bad(f, why.into()));
-                    }
-                    let (v, u) = finite(f, raw)?;
-                    if parameters.iter().any(|(q, _)| *q == p) {
-                        return Err(bad(f, format!("{} is given twice", p.name())));
-                    }
-                    parameters.push((p, v));
-                    parameter_rounding.push(u);
-                } else {
-                    return Err(bad(
-                        f,
-                        "unknown field (a scene parameter such as z_star, delta, phi_over_2pi, \
-                         end_tilt, K3, weight; the unknowns n0, m0 or u1_0, m2_0, u3_0; or a \
-                         claim: stable, lowest_omega2, twist, link, walled, knot, energy)"
-                            .into(),
-                    ));
-                }
+            "u1_0" | "m2_0" | "u3_0" => {
+                let slot = match field {
+                    "u1_0" => 3,
+                    "m2_0" => 4,
+                    _ => 5,
+                };
+                let value = self.finite(field, raw)?;
+                self.set(field, slot, value)?
             }
+            "stable" => self.claims.stable = self.flag(field, raw)?,
+            "walled" => self.claims.walled = self.flag(field, raw)?,
+            "lowest_omega2" => self.claims.lowest_omega2 = self.printed(field, raw)?,
+            "twist" => self.claims.twist = self.printed(field, raw)?,
+            "link" => self.claims.link = self.printed(field, raw)?,
+            "energy" => self.claims.energy = self.printed(field, raw)?,
+            "knot" => match raw {
+                Raw::Text(t) => self.claims.knot = Some(t.clone()),
+                _ => {
+                    return Err(self.bad(field, "a knot name such as \"3_1\" or \"0_1\"".into()));
+                }
+            },
+            _ => self.parameter(field, raw)?,
         }
+        Ok(())
     }
-    let names: [&str; 6] = if strip {
-        ["n0_1", "n0_2", "n0_3", "u1_0", "m2_0", "u3_0"]
-    } else {
-        ["n0_1", "n0_2", "n0_3", "m0_1", "m0_2", "m0_3"]
-    };
-    let mut values = [0.0; 6];
-    let mut rounding = [0.0; 6];
-    for k in 0..6 {
-        let (v, u) = unknowns[k].ok_or_else(|| bad(names[k], "missing".into()))?;
-        values[k] = v;
-        rounding[k] = u;
+
+    fn parameter(&mut self, field: &str, raw: &Raw) -> Result<(), VerifyFileError> {
+        let Some(p) = Parameter::named(field) else {
+            return Err(self.bad(
+                field,
+                "unknown field (a scene parameter such as z_star, delta, phi_over_2pi, \
+                 end_tilt, K3, weight; the unknowns n0, m0 or u1_0, m2_0, u3_0; or a \
+                 claim: stable, lowest_omega2, twist, link, walled, knot, energy)"
+                    .into(),
+            ));
+        };
+        if let Some(why) = absent_from(p, self.law) {
+            return Err(self.bad(field, why.into()));
+        }
+        let (v, u) = self.finite(field, raw)?;
+        if self.parameters.iter().any(|(q, _)| *q == p) {
+            return Err(self.bad(field, format!("{} is given twice", p.name())));
+        }
+        self.parameters.push((p, v));
+        self.parameter_rounding.push(u);
+        Ok(())
     }
-    Ok(Solution {
-        name,
-        parameters,
-        parameter_rounding,
-        unknowns: values,
-        rounding,
-        claims,
-        fold: None,
-    })
+
+    fn finish(self) -> Result<Solution, VerifyFileError> {
+        let names: [&str; 6] = if self.strip {
+            ["n0_1", "n0_2", "n0_3", "u1_0", "m2_0", "u3_0"]
+        } else {
+            ["n0_1", "n0_2", "n0_3", "m0_1", "m0_2", "m0_3"]
+        };
+        let mut values = [0.0; 6];
+        let mut rounding = [0.0; 6];
+        for k in 0..6 {
+            let (v, u) = self.unknowns[k].ok_or_else(|| self.bad(names[k], "missing".into()))?;
+            values[k] = v;
+            rounding[k] = u;
+        }
+        Ok(Solution {
+            name: self.name,
+            parameters: self.parameters,
+            parameter_rounding: self.parameter_rounding,
+            unknowns: values,
+            rounding,
+            claims: self.claims,
+            fold: None,
+        })
+    }
 }
 
 /// Why the law has no parameter `p`, if it has none.
