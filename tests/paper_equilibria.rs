@@ -41,7 +41,6 @@ fn appendix_d_good_knot() {
         3.0,
         3.0,
         &Clamps::new(0.115, 0.05, 0.802),
-        20_000,
     )
     .unwrap();
     let (n_ref, m_ref): ([f64; 3], [f64; 3]) = (n_ref.into(), m_ref.into());

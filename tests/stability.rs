@@ -99,7 +99,8 @@ fn stable_knot(n: usize) {
         3.0,
         3.0,
         4000,
-    );
+    )
+    .unwrap();
     let mut st = RodState::from_curve(n, clamps, |s| sol.position(s), |s| sol.d1(s));
     let mut newton = Minimizer::new(RodEnergy::new(model));
     newton

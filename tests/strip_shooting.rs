@@ -53,13 +53,13 @@ fn against_strip_shooting(
         weight: Vector3::from(model.weight),
         natural: model.natural_strains.clone(),
         clamps: scene.clamps(),
-        steps: 20_000,
+        intervals: 20_000,
     };
     let start = StripUnknowns::from_der(&newton.energy, &state);
     let p = problem
         .refine(start)
         .expect("strip shooting converges from the DER equilibrium");
-    let sol = problem.integrate(&p);
+    let sol = problem.integrate(&p).unwrap();
     assert!(sol.boundary_residual(&scene.clamps()).norm() < 1e-10);
     let (ns, ms) = sol.reactions();
     let mut knotted = false;

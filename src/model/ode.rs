@@ -1,35 +1,212 @@
-//! The fixed-step integrator of the reference shooting ODEs: classical RK4 on
-//! a uniform grid of [0, 1] and cubic Hermite interpolation between its
-//! samples (Newton on their s = 1 conditions is `solve::continuum::newton`).
+//! The one integrator of the continuum equations: an adaptive eighth-order
+//! Runge–Kutta method (Dormand–Prince 8(5,3), the `ode_solvers` crate, its
+//! 12th-stage node fixed in vendor/ode_solvers) from s = 0 to given stops or
+//! with dense output on a uniform grid, and cubic Hermite interpolation
+//! between such samples. The shooting references (`model::shooting`,
+//! `model::strip_shooting`) and the continuum check (`solve::continuum`)
+//! integrate through it alike.
 
 use nalgebra::SVector;
+use ode_solvers::{Dop853, OutputType, System};
 
-/// Samples y(k / steps), k = 0..=steps, of y' = f(s, y) from y(0) = `y0` by
-/// classical RK4.
-pub fn rk4<const D: usize>(
-    y0: SVector<f64, D>,
-    steps: usize,
-    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
-) -> Vec<SVector<f64, D>> {
-    let mut y = y0;
-    let ds = 1.0 / steps as f64;
-    let mut samples = Vec::with_capacity(steps + 1);
-    samples.push(y);
-    for k in 0..steps {
-        let s = k as f64 * ds;
-        let a = f(s, &y);
-        let b = f(s + 0.5 * ds, &(y + 0.5 * ds * a));
-        let c = f(s + 0.5 * ds, &(y + 0.5 * ds * b));
-        let d = f(s + ds, &(y + ds * c));
-        y += ds / 6.0 * (a + 2.0 * b + 2.0 * c + d);
-        samples.push(y);
+/// Steps of one integration before it counts as blown up (some hundred
+/// suffice for a knot).
+const MAX_STEPS: u32 = 20_000;
+
+/// The tolerance (absolute and relative) the shooting references integrate to.
+pub const REFERENCE_TOLERANCE: f64 = 1e-12;
+
+/// Why an integration stopped before its end.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum IntegrationFailure {
+    /// More than the step budget: the solution has blown up.
+    #[error("more than {MAX_STEPS} steps")]
+    TooManySteps,
+    /// The step fell below what f64 resolves.
+    #[error("the step size underflowed")]
+    StepSizeUnderflow,
+    /// The integrator's stiffness test fired.
+    #[error("the equations became stiff")]
+    Stiff,
+    /// A component became NaN or infinite.
+    #[error("the solution is not finite")]
+    NotFinite,
+    /// A stop outside [previous stop, 1].
+    #[error("stop s = {0} is not between the previous stop and 1")]
+    BadStop(f64),
+    /// The dense output did not give the asked samples.
+    #[error("the dense output gave {got} samples, not {asked}")]
+    Samples {
+        /// Samples made.
+        got: usize,
+        /// Samples asked.
+        asked: usize,
+    },
+}
+
+/// An integration that stopped before its end, with where.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("the equations could not be integrated past s = {s:.4}: {why}")]
+pub struct IntegrationError {
+    /// Where it stopped.
+    pub s: f64,
+    /// Why.
+    pub why: IntegrationFailure,
+}
+
+struct Rhs<F>(F);
+
+impl<F, const D: usize> System<f64, SVector<f64, D>> for Rhs<F>
+where
+    F: Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+{
+    fn system(&self, s: f64, y: &SVector<f64, D>, dy: &mut SVector<f64, D>) {
+        *dy = (self.0)(s, y);
     }
-    samples
+}
+
+/// y(1), y at the asked uniform samples of [0, 1], and the steps taken.
+#[derive(Clone, Debug)]
+pub struct Integrated<const D: usize> {
+    /// y(1), a step's own end.
+    pub end: SVector<f64, D>,
+    /// y(k / (samples − 1)), k = 0..samples (empty if fewer than 2 asked).
+    pub samples: Vec<SVector<f64, D>>,
+    /// Accepted steps.
+    pub steps: u32,
+}
+
+/// y' = f(s, y) from y(0) = `y0` to s = 1 at `tolerance`, with y at
+/// `samples` evenly spaced s if `samples` ≥ 2 (dense output of order 7).
+pub fn integrate<const D: usize>(
+    y0: SVector<f64, D>,
+    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+    tolerance: f64,
+    samples: usize,
+) -> Result<Integrated<D>, IntegrationError> {
+    let (ends, steps) = integrate_stops(y0, &f, tolerance, &[1.0])?;
+    let end = ends[0];
+    if samples < 2 {
+        return Ok(Integrated {
+            end,
+            samples: vec![],
+            steps,
+        });
+    }
+    let dx = 1.0 / (samples - 1) as f64;
+    // (Dense is the crate's default output)
+    let mut solver = Dop853::new(Rhs(&f), 0.0, 1.0, dx, y0, tolerance, tolerance);
+    solver.integrate().map_err(failure)?;
+    let mut dense: Vec<SVector<f64, D>> = solver.y_out().to_vec();
+    // the crate's dense output at s = 1 itself is an extrapolation (errors
+    // of 1e-10 seen); the step's own y(1) is exact to the tolerance
+    if let Some(last) = dense.last_mut() {
+        *last = end;
+    }
+    if dense.len() != samples {
+        return Err(IntegrationError {
+            s: 1.0,
+            why: IntegrationFailure::Samples {
+                got: dense.len(),
+                asked: samples,
+            },
+        });
+    }
+    if dense.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(IntegrationError {
+            s: 1.0,
+            why: IntegrationFailure::NotFinite,
+        });
+    }
+    Ok(Integrated {
+        end,
+        samples: dense,
+        steps,
+    })
+}
+
+/// The crate's failure, with where it stopped.
+fn failure(e: ode_solvers::dop_shared::IntegrationError) -> IntegrationError {
+    use ode_solvers::dop_shared::IntegrationError as E;
+    match e {
+        E::MaxNumStepReached { x, .. } => IntegrationError {
+            s: x,
+            why: IntegrationFailure::TooManySteps,
+        },
+        E::StepSizeUnderflow { x } => IntegrationError {
+            s: x,
+            why: IntegrationFailure::StepSizeUnderflow,
+        },
+        E::StiffnessDetected { x } => IntegrationError {
+            s: x,
+            why: IntegrationFailure::Stiff,
+        },
+    }
+}
+
+/// y at each of the increasing `stops` in (0, 1] of y' = f(s, y) from
+/// y(0) = `y0`, to `tolerance`, and the steps taken: each piece is
+/// integrated afresh from the last stop, so every stop is a step's own end
+/// (no interpolation).
+pub fn integrate_stops<const D: usize>(
+    y0: SVector<f64, D>,
+    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+    tolerance: f64,
+    stops: &[f64],
+) -> Result<(Vec<SVector<f64, D>>, u32), IntegrationError> {
+    let mut y = y0;
+    let mut from = 0.0;
+    let mut out = Vec::with_capacity(stops.len());
+    let mut steps = 0;
+    for &to in stops {
+        if !(to >= from && to <= 1.0) {
+            return Err(IntegrationError {
+                s: from,
+                why: IntegrationFailure::BadStop(to),
+            });
+        }
+        if to > from {
+            // the crate's defaults but the step budget
+            let mut solver = Dop853::from_param(
+                Rhs(&f),
+                from,
+                to,
+                to - from,
+                y,
+                tolerance,
+                tolerance,
+                0.9,
+                0.0,
+                0.333,
+                6.0,
+                to - from,
+                0.0,
+                MAX_STEPS,
+                1000,
+                OutputType::Sparse,
+            );
+            steps += solver.integrate().map_err(failure)?.accepted_steps;
+            // the crate's sparse output holds at least the end
+            y = *solver.y_out().last().ok_or(IntegrationError {
+                s: from,
+                why: IntegrationFailure::TooManySteps,
+            })?;
+            if y.iter().any(|v| !v.is_finite()) {
+                return Err(IntegrationError {
+                    s: to,
+                    why: IntegrationFailure::NotFinite,
+                });
+            }
+        }
+        out.push(y);
+        from = to;
+    }
+    Ok((out, steps))
 }
 
 /// y(s) between the uniform `samples` of [0, 1] by cubic Hermite
-/// interpolation with the exact derivative f(s, y) at both ends of its step
-/// (fourth order, as RK4 itself).
+/// interpolation with the exact derivative f(s, y) at both ends of its
+/// interval (fourth order in the spacing).
 pub fn hermite<const D: usize>(
     samples: &[SVector<f64, D>],
     s: f64,
@@ -47,4 +224,60 @@ pub fn hermite<const D: usize>(
     let h01 = -2.0 * t * t * t + 3.0 * t * t;
     let h11 = t * t * t - t * t;
     h00 * y0 + h10 * ds * f0 + h01 * y1 + h11 * ds * f1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An equation that depends on s (as natural strains varying along the
+    /// rod make the rod's): y' = (8 s⁷, cos s), integrated to 1e-12 in a few
+    /// steps. The crate's DOP853 evaluated its 12th stage at the step's start
+    /// (vendor/ode_solvers, c12 fixed): this took hundreds of steps or
+    /// stopped as "stiff".
+    #[test]
+    fn an_equation_that_depends_on_s_is_integrated_to_its_tolerance() {
+        let f = |s: f64, _: &SVector<f64, 2>| SVector::<f64, 2>::new(8.0 * s.powi(7), s.cos());
+        let solved = integrate(SVector::<f64, 2>::zeros(), f, 1e-12, 5).unwrap();
+        let end = solved.end;
+        assert!((end[0] - 1.0).abs() < 1e-12, "{}", end[0] - 1.0);
+        assert!(
+            (end[1] - 1f64.sin()).abs() < 1e-12,
+            "{}",
+            end[1] - 1f64.sin()
+        );
+        assert!(solved.steps < 40, "{} steps", solved.steps);
+        // the dense output at s = 0.5 too
+        assert!((solved.samples[2][0] - 0.5f64.powi(8)).abs() < 1e-10);
+        assert!((solved.samples[2][1] - 0.5f64.sin()).abs() < 1e-10);
+    }
+
+    #[test]
+    fn a_blown_up_solution_is_an_error_with_where_it_stopped() {
+        // y' = y² from y(0) = 2 blows up at s = 1/2
+        let f = |_: f64, y: &SVector<f64, 1>| SVector::<f64, 1>::new(y[0] * y[0]);
+        let e = integrate(SVector::<f64, 1>::new(2.0), f, 1e-10, 0).unwrap_err();
+        assert!((e.s - 0.5).abs() < 1e-3, "{e}");
+        let e = integrate_stops(SVector::<f64, 1>::new(0.0), f, 1e-10, &[0.5, 0.2]).unwrap_err();
+        assert_eq!(e.why, IntegrationFailure::BadStop(0.2));
+    }
+
+    #[test]
+    fn hermite_samples_interpolate_at_fourth_order() {
+        // y = (sin s, cos s): the interpolation error falls 16-fold as the
+        // spacing halves
+        let f = |_: f64, y: &SVector<f64, 2>| SVector::<f64, 2>::new(y[1], -y[0]);
+        let error = |n: usize| {
+            let samples: Vec<_> = (0..=n)
+                .map(|k| {
+                    let s = k as f64 / n as f64;
+                    SVector::<f64, 2>::new(s.sin(), s.cos())
+                })
+                .collect();
+            let s = 0.5 / n as f64 + 0.3;
+            (hermite(&samples, s, f)[0] - s.sin()).abs()
+        };
+        let ratio = error(20) / error(40);
+        assert!((ratio - 16.0).abs() < 1.0, "{ratio}");
+    }
 }

@@ -3,7 +3,9 @@
 //! an independent reference (the paper's own method) in validation.
 
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::{hermite, rk4};
+use crate::model::ode::{
+    IntegrationError, REFERENCE_TOLERANCE, hermite, integrate, integrate_stops,
+};
 use crate::model::rod::{Clamps, EndKind, wrap};
 use nalgebra::{SVector, Vector3, Vector6};
 use std::f64::consts::PI;
@@ -52,10 +54,11 @@ pub fn rhs_loaded(
     f
 }
 
-/// A solution of (A.2) on [0, 1] sampled on a uniform grid (classical RK4).
+/// A solution of (A.2) on [0, 1], integrated to [`REFERENCE_TOLERANCE`] and
+/// sampled on a uniform grid (the integrator's dense output).
 #[derive(Clone, Debug)]
 pub struct ShootingSolution {
-    /// Samples at s = k / steps.
+    /// Samples at s = k / intervals.
     pub samples: Vec<OdeState>,
     /// Bending ratios.
     pub k2: f64,
@@ -68,10 +71,17 @@ pub struct ShootingSolution {
 }
 
 impl ShootingSolution {
-    /// Integrate from r = 0, d_i = e_i, with n(0), m(0) in the material frame.
-    pub fn integrate(n0: Vector3<f64>, m0: Vector3<f64>, k2: f64, k3: f64, steps: usize) -> Self {
+    /// Integrate from r = 0, d_i = e_i, with n(0), m(0) in the material
+    /// frame, sampled at `intervals` + 1 points.
+    pub fn integrate(
+        n0: Vector3<f64>,
+        m0: Vector3<f64>,
+        k2: f64,
+        k3: f64,
+        intervals: usize,
+    ) -> Result<Self, IntegrationError> {
         let straight = NaturalStrains::default();
-        Self::integrate_loaded(n0, m0, k2, k3, Vector3::zeros(), straight, steps)
+        Self::integrate_loaded(n0, m0, k2, k3, Vector3::zeros(), straight, intervals)
     }
 
     /// As `integrate`, under a body force `weight` per unit length (lab
@@ -83,15 +93,15 @@ impl ShootingSolution {
         k3: f64,
         weight: Vector3<f64>,
         natural: NaturalStrains,
-        steps: usize,
-    ) -> Self {
+        intervals: usize,
+    ) -> Result<Self, IntegrationError> {
         Self::integrate_from(
             &Clamps::new(0.0, 0.0, 0.0),
             n0,
             m0,
             [k2, k3],
             (weight, natural),
-            steps,
+            intervals,
         )
     }
 
@@ -103,22 +113,18 @@ impl ShootingSolution {
         m0: Vector3<f64>,
         [k2, k3]: [f64; 2],
         (weight, natural): (Vector3<f64>, NaturalStrains),
-        steps: usize,
-    ) -> Self {
+        intervals: usize,
+    ) -> Result<Self, IntegrationError> {
         let f = |s: f64, y: &OdeState| rhs_loaded(y, k2, k3, &weight, &natural.vector_at(s));
-        let mut y = start_frame(clamps);
-        for c in 0..3 {
-            y[12 + c] = n0[c];
-            y[15 + c] = m0[c];
-        }
-        let samples = rk4(y, steps, f);
-        ShootingSolution {
+        let y0 = start_state(clamps, n0, m0);
+        let samples = integrate(y0, f, REFERENCE_TOLERANCE, intervals.max(1) + 1)?.samples;
+        Ok(ShootingSolution {
             samples,
             k2,
             k3,
             weight,
             natural,
-        }
+        })
     }
 
     /// State at s by cubic Hermite interpolation with the exact derivative (A.2).
@@ -161,16 +167,57 @@ impl ShootingSolution {
     /// At a pinned end: r(1) − r* and m(1); at a free end: n(1) and m(1)
     /// (the natural conditions, in material components).
     pub fn boundary_residual(&self, clamps: &Clamps) -> Vector6<f64> {
-        let y = self.end();
-        let (n1, m1) = (part(y, 4), part(y, 5));
-        match clamps.ends.end {
-            EndKind::Clamped => end_mismatch([part(y, 0), part(y, 1), part(y, 3)], clamps),
-            EndKind::Pinned => {
-                let r = part(y, 0) - clamps.end_point();
-                Vector6::new(r[0], r[1], r[2], m1[0], m1[1], m1[2])
-            }
-            EndKind::Free => Vector6::new(n1[0], n1[1], n1[2], m1[0], m1[1], m1[2]),
+        end_residual(self.end(), clamps)
+    }
+}
+
+/// The s = 1 residual of the solution of (A.2) from n(0), m(0) at the s = 0
+/// clamp of `clamps` (as [`ShootingSolution::boundary_residual`], integrated
+/// to its end only).
+pub fn shooting_residual(
+    clamps: &Clamps,
+    n0: Vector3<f64>,
+    m0: Vector3<f64>,
+    [k2, k3]: [f64; 2],
+    (weight, natural): (Vector3<f64>, &NaturalStrains),
+) -> Result<Vector6<f64>, IntegrationError> {
+    let f = |s: f64, y: &OdeState| rhs_loaded(y, k2, k3, &weight, &natural.vector_at(s));
+    let (ends, _) = integrate_stops(start_state(clamps, n0, m0), f, REFERENCE_TOLERANCE, &[1.0])?;
+    Ok(end_residual(&ends[0], clamps))
+}
+
+fn start_state(clamps: &Clamps, n0: Vector3<f64>, m0: Vector3<f64>) -> OdeState {
+    let mut y = start_frame(clamps);
+    for c in 0..3 {
+        y[12 + c] = n0[c];
+        y[15 + c] = m0[c];
+    }
+    y
+}
+
+fn end_residual(y: &OdeState, clamps: &Clamps) -> Vector6<f64> {
+    end_conditions(
+        [part(y, 0), part(y, 1), part(y, 3)],
+        (part(y, 4), part(y, 5)),
+        clamps,
+    )
+}
+
+/// The s = 1 conditions of `clamps` at an end r, d1, d3 with force and
+/// moment n, m (material components): clamped, [`end_mismatch`]; pinned,
+/// r(1) − r* and m(1); free, n(1) and m(1) (the natural conditions).
+pub fn end_conditions(
+    rd: [Vector3<f64>; 3],
+    (n1, m1): (Vector3<f64>, Vector3<f64>),
+    clamps: &Clamps,
+) -> Vector6<f64> {
+    match clamps.ends.end {
+        EndKind::Clamped => end_mismatch(rd, clamps),
+        EndKind::Pinned => {
+            let r = rd[0] - clamps.end_point();
+            Vector6::new(r[0], r[1], r[2], m1[0], m1[1], m1[2])
         }
+        EndKind::Free => Vector6::new(n1[0], n1[1], n1[2], m1[0], m1[1], m1[2]),
     }
 }
 

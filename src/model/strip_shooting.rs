@@ -19,7 +19,9 @@
 use crate::linalg::jet;
 use crate::model::energy::{RodEnergy, strip_energy, vertex_strains};
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::{hermite, rk4};
+use crate::model::ode::{
+    IntegrationError, REFERENCE_TOLERANCE, hermite, integrate, integrate_stops,
+};
 use crate::model::rod::{Clamps, RodState};
 use crate::model::shooting::end_mismatch;
 use nalgebra::{Matrix2, SVector, Vector2, Vector3, Vector6};
@@ -63,6 +65,9 @@ pub enum StripShootingError {
     /// The Jacobian of the s = 1 conditions was singular or not finite.
     #[error("strip shooting: singular or non-finite Jacobian of the s = 1 conditions")]
     Singular,
+    /// The strip's equations could not be integrated from the unknowns.
+    #[error("strip shooting: {0}")]
+    Integration(#[from] IntegrationError),
 }
 
 /// The Sadowsky density W(a, u3) of the DER (`strip_energy` at h = 1): its
@@ -158,11 +163,12 @@ pub fn strip_rhs(
     f
 }
 
-/// A solution of the strip ODE on [0, 1] sampled on a uniform grid
-/// (classical RK4).
+/// A solution of the strip ODE on [0, 1], integrated to
+/// [`REFERENCE_TOLERANCE`] and sampled on a uniform grid (the integrator's
+/// dense output).
 #[derive(Clone, Debug)]
 pub struct StripSolution {
-    /// Samples at s = k / steps.
+    /// Samples at s = k / intervals.
     pub samples: Vec<StripOdeState>,
     /// ε of the Sadowsky law.
     pub regularisation: f64,
@@ -173,35 +179,25 @@ pub struct StripSolution {
 }
 
 impl StripSolution {
-    /// Integrate from r = 0, d_i = e_i with the unknowns `p`; m1(0), m3(0)
-    /// follow from the law (4.2) at s = 0.
+    /// Integrate from r = 0, d_i = e_i with the unknowns `p`, sampled at
+    /// `intervals` + 1 points; m1(0), m3(0) follow from the law (4.2) at
+    /// s = 0.
     pub fn integrate(
         p: &StripUnknowns,
         regularisation: f64,
         weight: Vector3<f64>,
         natural: NaturalStrains,
-        steps: usize,
-    ) -> Self {
-        let steps = steps.max(1);
-        let a0 = p.u1 - natural.at(0.0)[0];
-        let (m13, _) = sadowsky(a0, p.u3, regularisation);
-        let mut y = StripOdeState::zeros();
-        y[3] = 1.0;
-        y[7] = 1.0;
-        y[11] = 1.0;
-        set(&mut y, 4, p.n0);
-        set(&mut y, 5, Vector3::new(m13[0], p.m2, m13[1]));
-        y[A] = a0;
-        y[U3] = p.u3;
-        let samples = rk4(y, steps, |s, y| {
-            strip_rhs(s, y, regularisation, &weight, &natural)
-        });
-        StripSolution {
+        intervals: usize,
+    ) -> Result<Self, IntegrationError> {
+        let y0 = strip_start(p, regularisation, &natural);
+        let f = |s: f64, y: &StripOdeState| strip_rhs(s, y, regularisation, &weight, &natural);
+        let samples = integrate(y0, f, REFERENCE_TOLERANCE, intervals.max(1) + 1)?.samples;
+        Ok(StripSolution {
             samples,
             regularisation,
             weight,
             natural,
-        }
+        })
     }
 
     /// State at s by cubic Hermite interpolation with the exact derivative.
@@ -251,8 +247,24 @@ impl StripSolution {
     }
 }
 
+/// The strip's state at s = 0 from the unknowns `p`: r = 0, d_i = e_i,
+/// m1(0), m3(0) from the law (4.2).
+fn strip_start(p: &StripUnknowns, regularisation: f64, natural: &NaturalStrains) -> StripOdeState {
+    let a0 = p.u1 - natural.at(0.0)[0];
+    let (m13, _) = sadowsky(a0, p.u3, regularisation);
+    let mut y = StripOdeState::zeros();
+    y[3] = 1.0;
+    y[7] = 1.0;
+    y[11] = 1.0;
+    set(&mut y, 4, p.n0);
+    set(&mut y, 5, Vector3::new(m13[0], p.m2, m13[1]));
+    y[A] = a0;
+    y[U3] = p.u3;
+    y
+}
+
 /// The strip problem to shoot: its law, load, natural strains, clamps and
-/// RK4 steps.
+/// the samples of its solutions.
 #[derive(Clone, Debug)]
 pub struct StripProblem {
     /// ε of the Sadowsky law.
@@ -263,25 +275,34 @@ pub struct StripProblem {
     pub natural: NaturalStrains,
     /// The s = 1 clamp.
     pub clamps: Clamps,
-    /// RK4 steps on [0, 1].
-    pub steps: usize,
+    /// Intervals of [0, 1] a solution is sampled at.
+    pub intervals: usize,
 }
 
 impl StripProblem {
     /// The solution from the unknowns `p`.
-    pub fn integrate(&self, p: &StripUnknowns) -> StripSolution {
+    pub fn integrate(&self, p: &StripUnknowns) -> Result<StripSolution, IntegrationError> {
         StripSolution::integrate(
             p,
             self.regularisation,
             self.weight,
             self.natural.clone(),
-            self.steps,
+            self.intervals,
         )
     }
 
-    /// The s = 1 residual of the solution from `p`.
-    pub fn residual(&self, p: &StripUnknowns) -> Vector6<f64> {
-        self.integrate(p).boundary_residual(&self.clamps)
+    /// The s = 1 residual of the solution from `p` (integrated to its end
+    /// only).
+    pub fn residual(&self, p: &StripUnknowns) -> Result<Vector6<f64>, IntegrationError> {
+        let (r, w, natural) = (self.regularisation, &self.weight, &self.natural);
+        let f = |s: f64, y: &StripOdeState| strip_rhs(s, y, r, w, natural);
+        let y0 = strip_start(p, r, natural);
+        let (ends, _) = integrate_stops(y0, f, REFERENCE_TOLERANCE, &[1.0])?;
+        let y = &ends[0];
+        Ok(end_mismatch(
+            [part(y, 0), part(y, 1), part(y, 3)],
+            &self.clamps,
+        ))
     }
 }
 
@@ -315,7 +336,7 @@ mod tests {
             u3: 0.0,
         };
         let natural = NaturalStrains::from([1.0, 0.0, 0.0]);
-        let sol = StripSolution::integrate(&p, 0.05, Vector3::zeros(), natural, 20_000);
+        let sol = StripSolution::integrate(&p, 0.05, Vector3::zeros(), natural, 20_000).unwrap();
         let ring = Clamps::new(0.0, 0.0, 1.0);
         assert!(sol.boundary_residual(&ring).norm() < 1e-10);
         let r = sol.position(0.125);

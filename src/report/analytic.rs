@@ -7,10 +7,12 @@
 
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::model::energy::{RodEnergy, Terms};
+use crate::model::ode::integrate_stops;
 use crate::model::rod::{Clamps, EndKind, RodModel, RodState};
-use crate::report::error::{Result, fail};
+use crate::report::error::{ReportError, Result, fail};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolverSettings;
+use nalgebra::SVector;
 use std::f64::consts::PI;
 
 /// The straight (uniformly twisted) equilibrium for `clamps`, stable or not,
@@ -175,40 +177,24 @@ pub fn free_semicircle(n: usize) -> Result<(f64, f64, f64)> {
 
 /// The continuum heavy column's critical weight: the smallest w with a
 /// nonzero solution of θ'' + w (1 − s) θ = 0, θ(0) = 0 (clamped base),
-/// θ'(1) = 0 (free top, no moment), by RK4 and bisection on θ'(1): 7.83735,
-/// the first zero of J₋₁/₃(2/3 √w) (classically w L³/EI = 7.837).
-pub fn heavy_column_constant() -> f64 {
-    let end_slope = |w: f64| {
-        let f = |s: f64, y: [f64; 2]| [y[1], -w * (1.0 - s) * y[0]];
-        let steps = 2000;
-        let ds = 1.0 / steps as f64;
-        let mut y = [0.0, 1.0];
-        for k in 0..steps {
-            let s = k as f64 * ds;
-            let a = f(s, y);
-            let b = f(
-                s + 0.5 * ds,
-                [y[0] + 0.5 * ds * a[0], y[1] + 0.5 * ds * a[1]],
-            );
-            let c = f(
-                s + 0.5 * ds,
-                [y[0] + 0.5 * ds * b[0], y[1] + 0.5 * ds * b[1]],
-            );
-            let d = f(s + ds, [y[0] + ds * c[0], y[1] + ds * c[1]]);
-            for i in 0..2 {
-                y[i] += ds / 6.0 * (a[i] + 2.0 * b[i] + 2.0 * c[i] + d[i]);
-            }
-        }
-        y[1]
+/// θ'(1) = 0 (free top, no moment), by the continuum integrator and
+/// bisection on θ'(1): 7.83735, the first zero of J₋₁/₃(2/3 √w)
+/// (classically w L³/EI = 7.837).
+pub fn heavy_column_constant() -> Result<f64> {
+    let end_slope = |w: f64| -> Result<f64> {
+        let f = |s: f64, y: &SVector<f64, 2>| SVector::<f64, 2>::new(y[1], -w * (1.0 - s) * y[0]);
+        let (ends, _) = integrate_stops(SVector::<f64, 2>::new(0.0, 1.0), f, 1e-13, &[1.0])
+            .map_err(|e| ReportError::Failed(format!("heavy column at w = {w}: {e}")))?;
+        Ok(ends[0][1])
     };
     let (mut lo, mut hi) = (6.0, 9.0);
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
-        if end_slope(mid) > 0.0 {
+        if end_slope(mid)? > 0.0 {
             lo = mid
         } else {
             hi = mid
         }
     }
-    0.5 * (lo + hi)
+    Ok(0.5 * (lo + hi))
 }

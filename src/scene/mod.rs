@@ -381,7 +381,8 @@ pub struct InitialSpec {
     /// Refine the shooting data by Newton on the s = 1 boundary conditions first.
     #[serde(default)]
     pub refine: bool,
-    /// RK4 steps for the shooting integration; for "double_ring", the
+    /// For "shooting", the intervals the integrated solution (adaptive, to
+    /// 1e-12) is sampled at for the start (default 20 000); for "double_ring", the
     /// quasi-static steps that unfold it to the scene's clamps (default 40).
     #[serde(default)]
     pub steps: Option<i64>,

@@ -591,7 +591,7 @@ impl Scene {
                 }
             }
         }
-        // RK4 steps of a shooting start, or unfolding steps of the double ring
+        // sample intervals of a shooting start, or unfolding steps of the double ring
         // (each unfolding step is a Newton solve: far fewer of them)
         let (least, most) = if i.shape == InitialShape::DoubleRing {
             (1, 10_000)

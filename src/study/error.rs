@@ -29,6 +29,9 @@ pub enum StudyError {
     /// Strip shooting (a continuum start) did not converge.
     #[error(transparent)]
     StripShooting(#[from] StripShootingError),
+    /// The continuum equations could not be integrated (a shooting start).
+    #[error(transparent)]
+    Integration(#[from] crate::model::ode::IntegrationError),
     /// The continuum check (adaptive shooting) failed.
     #[error(transparent)]
     Continuum(#[from] crate::solve::continuum::ContinuumError),

@@ -125,19 +125,11 @@ fn shooting(init: &InitialSpec, model: &RodModel, clamps: Clamps) -> Result<RodS
         Vector3::from(init.n0.context("initial.n0 missing")?),
         Vector3::from(init.m0.context("initial.m0 missing")?),
     );
-    let steps = init.steps.map_or(20_000, |s| s as usize);
+    let intervals = init.steps.map_or(20_000, |s| s as usize);
     let (weight, natural) = (Vector3::from(model.weight), &model.natural_strains);
     if init.refine {
-        (n0, m0) = refine_shooting_loaded(
-            n0,
-            m0,
-            model.k2,
-            model.k3,
-            (weight, natural),
-            &clamps,
-            steps,
-        )
-        .context("initial.refine: shooting refinement did not converge")?;
+        (n0, m0) = refine_shooting_loaded(n0, m0, model.k2, model.k3, (weight, natural), &clamps)
+            .context("initial.refine: shooting refinement did not converge")?;
     }
     let sol = ShootingSolution::integrate_from(
         &clamps,
@@ -145,8 +137,9 @@ fn shooting(init: &InitialSpec, model: &RodModel, clamps: Clamps) -> Result<RodS
         m0,
         [model.k2, model.k3],
         (weight, natural.clone()),
-        steps,
-    );
+        intervals,
+    )
+    .context("initial: integrating the shooting data")?;
     Ok(RodState::from_curve(
         model.segments,
         clamps,
@@ -178,14 +171,16 @@ fn strip_shooting(
         weight: Vector3::from(model.weight),
         natural: model.natural_strains.clone(),
         clamps,
-        steps: init.steps.map_or(20_000, |s| s as usize),
+        intervals: init.steps.map_or(20_000, |s| s as usize),
     };
     if init.refine {
         p = problem
             .refine(p)
             .context("initial.refine: strip shooting refinement")?;
     }
-    let sol = problem.integrate(&p);
+    let sol = problem
+        .integrate(&p)
+        .context("initial: integrating the strip's shooting data")?;
     Ok(RodState::from_curve(
         model.segments,
         clamps,

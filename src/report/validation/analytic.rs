@@ -132,7 +132,7 @@ fn free_end_tables() -> Result<String> {
         writeln!(s, "| {n} | {tip:.8} | {e:.2e} | {p} |")?;
         prev = Some(e);
     }
-    let exact = heavy_column_constant();
+    let exact = heavy_column_constant()?;
     writeln!(
         s,
         "\n### Greenhill's heavy column (clamped at the base, free at the top, isotropic; continuum w L³/B = {exact:.6}, the first zero of J₋₁/₃(2/3 √(w L³/B)), classically 7.837)\n"

@@ -47,9 +47,10 @@ pub fn continuum_reference(scene: &Scene) -> Option<([f64; 3], [f64; 3], f64)> {
         model.k2,
         model.k3,
         &scene.clamps(),
-        40_000,
     )?;
-    let tw = ShootingSolution::integrate(n0, m0, model.k2, model.k3, 40_000).twist();
+    let tw = ShootingSolution::integrate(n0, m0, model.k2, model.k3, 1)
+        .ok()?
+        .twist();
     Some((n0.into(), m0.into(), tw))
 }
 

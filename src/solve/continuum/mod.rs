@@ -1,16 +1,15 @@
 //! The continuum equilibrium integrated to a tolerance: the Kirchhoff
 //! equations (A.2) and the strip's (A.1 with 4.3) from the six shooting
-//! unknowns at s = 0, by an adaptive eighth-order Runge–Kutta method
-//! (Dormand–Prince 8(5,3), the `ode_solvers` crate), with the energy and the
+//! unknowns at s = 0, by the one integrator of the continuum equations
+//! (`model::ode`: adaptive Dormand–Prince 8(5,3)), with the energy and the
 //! weight's potential integrated alongside. This is the independent check of
 //! `knotrod verify`: it shares the equations' right-hand sides with
-//! `shooting.rs` and `strip_shooting.rs` but neither their fixed-step RK4 nor
-//! anything of the discrete rod.
+//! `shooting.rs` and `strip_shooting.rs` and nothing of the discrete rod.
 //!
 //! The solvers of the continuum equations live here (`solve`), the equations
 //! themselves in `model` (`model::shooting`, `model::strip_shooting`: the
 //! right-hand sides, the s = 1 conditions, the strip's law): [`newton`] is
-//! Newton shooting, [`shooting`] refines the reference RK4 solutions by it,
+//! Newton shooting, [`shooting`] refines the reference solutions by it,
 //! [`branch`] continues a continuum solution in a clamp parameter and locates
 //! events on it, [`stability`] counts and finds the frequencies of the
 //! linearised problem by shooting its determinant.
@@ -22,12 +21,12 @@ pub mod stability;
 
 use crate::model::energy::strip_energy;
 use crate::model::natural::NaturalStrains;
+use crate::model::ode::{Integrated, IntegrationError, integrate, integrate_stops};
 use crate::model::rod::{Clamps, EndKind, Law, RodModel};
-use crate::model::shooting::{OdeState, end_mismatch, rhs_loaded, start_frame};
+use crate::model::shooting::{OdeState, end_conditions, rhs_loaded, start_frame};
 use crate::model::strip_shooting::{StripOdeState, sadowsky, strip_rhs};
 use crate::solve::continuum::newton::{NewtonShootingFailure, central_jacobian, newton_shooting};
 use nalgebra::{Matrix6, SVector, Vector3, Vector6};
-use ode_solvers::{Dop853, OutputType, System};
 use std::f64::consts::PI;
 
 /// Why a continuum solution could not be made.
@@ -40,13 +39,8 @@ pub enum ContinuumError {
     #[error("shooting unknown {0} is not finite")]
     NotFinite(usize),
     /// The adaptive integrator stopped before s = 1.
-    #[error("the continuum equations could not be integrated past s = {s:.4}: {reason}")]
-    Integration {
-        /// Where it stopped.
-        s: f64,
-        /// The integrator's reason.
-        reason: String,
-    },
+    #[error("continuum: {0}")]
+    Integration(#[from] IntegrationError),
     /// Newton did not bring the s = 1 residual below its tolerance.
     #[error(
         "shooting Newton did not converge in {iterations} iterations (residual {residual:.3e})"
@@ -137,132 +131,8 @@ const NEWTON_ITERATIONS: usize = 40;
 const ROD: usize = 21;
 // the strip's state then ∫W ds and ∫ w g·r ds
 const STRIP: usize = 23;
-/// Steps of one integration before it counts as blown up.
-const MAX_STEPS: u32 = 20_000;
 // the rod's state (A.2) and its derivatives in the six unknowns
 pub(crate) const VARIATIONAL: usize = 19 * 7;
-
-struct Rhs<F>(F);
-
-impl<F, const D: usize> System<f64, SVector<f64, D>> for Rhs<F>
-where
-    F: Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
-{
-    fn system(&self, s: f64, y: &SVector<f64, D>, dy: &mut SVector<f64, D>) {
-        *dy = (self.0)(s, y);
-    }
-}
-
-/// y(1), y at the asked samples, and the steps taken.
-type Integrated<const D: usize> = (SVector<f64, D>, Vec<SVector<f64, D>>, u32);
-
-/// y(1) of y' = f(s, y) from y(0) = `y0` to `tolerance`, and y at
-/// `samples` evenly spaced s if asked (dense output of order 7).
-fn integrate<const D: usize>(
-    y0: SVector<f64, D>,
-    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
-    tolerance: f64,
-    samples: usize,
-) -> Result<Integrated<D>, ContinuumError> {
-    let (ends, steps) = integrate_stops(y0, &f, tolerance, &[1.0])?;
-    let end = ends[0];
-    if samples < 2 {
-        return Ok((end, vec![], steps));
-    }
-    let start = y0;
-    let dx = 1.0 / (samples - 1) as f64;
-    // (Dense is the crate's default output)
-    let mut solver = Dop853::new(Rhs(&f), 0.0, 1.0, dx, start, tolerance, tolerance);
-    solver.integrate().map_err(integration_error)?;
-    let mut dense: Vec<SVector<f64, D>> = solver.y_out().to_vec();
-    // the crate's dense output at s = 1 itself is an extrapolation (errors
-    // of 1e-10 seen); the step's own y(1) is exact to the tolerance
-    if let Some(last) = dense.last_mut() {
-        *last = end;
-    }
-    if dense.len() != samples {
-        return Err(ContinuumError::Integration {
-            s: 1.0,
-            reason: format!("dense output gave {} samples, not {samples}", dense.len()),
-        });
-    }
-    Ok((end, dense, steps))
-}
-
-/// The integrator's failure, with where it stopped.
-fn integration_error(e: ode_solvers::dop_shared::IntegrationError) -> ContinuumError {
-    use ode_solvers::dop_shared::IntegrationError as E;
-    ContinuumError::Integration {
-        s: match e {
-            E::MaxNumStepReached { x, .. }
-            | E::StepSizeUnderflow { x }
-            | E::StiffnessDetected { x } => x,
-        },
-        reason: e.to_string(),
-    }
-}
-
-/// y at each of the increasing `stops` in (0, 1] of y' = f(s, y) from
-/// y(0) = `y0`, to `tolerance`: each piece is integrated afresh from the
-/// last stop, so every stop is a step's own end (no interpolation).
-pub(crate) fn integrate_stops<const D: usize>(
-    y0: SVector<f64, D>,
-    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
-    tolerance: f64,
-    stops: &[f64],
-) -> Result<(Vec<SVector<f64, D>>, u32), ContinuumError> {
-    let mut y = y0;
-    let mut from = 0.0;
-    let mut out = Vec::with_capacity(stops.len());
-    let mut steps = 0;
-    for &to in stops {
-        if !(to >= from && to <= 1.0) {
-            return Err(ContinuumError::Integration {
-                s: from,
-                reason: format!("stop s = {to} is not in [{from}, 1]"),
-            });
-        }
-        if to > from {
-            // the crate's defaults, but a solution needing more than
-            // MAX_STEPS steps (some hundred suffice for a knot) has blown up
-            let mut solver = Dop853::from_param(
-                Rhs(&f),
-                from,
-                to,
-                to - from,
-                y,
-                tolerance,
-                tolerance,
-                0.9,
-                0.0,
-                0.333,
-                6.0,
-                to - from,
-                0.0,
-                MAX_STEPS,
-                1000,
-                OutputType::Sparse,
-            );
-            steps += solver
-                .integrate()
-                .map_err(integration_error)?
-                .accepted_steps;
-            y = *solver.y_out().last().ok_or(ContinuumError::Integration {
-                s: from,
-                reason: "no step".into(),
-            })?;
-            if y.iter().any(|v| !v.is_finite()) {
-                return Err(ContinuumError::Integration {
-                    s: to,
-                    reason: "the solution is not finite".into(),
-                });
-            }
-        }
-        out.push(y);
-        from = to;
-    }
-    Ok((out, steps))
-}
 
 fn check_finite(p: &Unknowns) -> Result<(), ContinuumError> {
     match p.iter().position(|v| !v.is_finite()) {
@@ -556,7 +426,11 @@ impl Continuum {
         &self,
         p: &Unknowns,
         m0: Vector3<f64>,
-        (end, dense, steps): Integrated<D>,
+        Integrated {
+            end,
+            samples: dense,
+            steps,
+        }: Integrated<D>,
         twist: usize,
     ) -> ContinuumSolution {
         ContinuumSolution {
@@ -576,16 +450,9 @@ impl Continuum {
     pub(crate) fn end_residual(
         &self,
         rd: [Vector3<f64>; 3],
-        (n1, m1): (Vector3<f64>, Vector3<f64>),
+        nm: (Vector3<f64>, Vector3<f64>),
     ) -> Vector6<f64> {
-        match self.clamps.ends.end {
-            EndKind::Clamped => end_mismatch(rd, &self.clamps),
-            EndKind::Pinned => {
-                let r = rd[0] - self.clamps.end_point();
-                Vector6::new(r[0], r[1], r[2], m1[0], m1[1], m1[2])
-            }
-            EndKind::Free => Vector6::new(n1[0], n1[1], n1[2], m1[0], m1[1], m1[2]),
-        }
+        end_conditions(rd, nm, &self.clamps)
     }
 
     /// The s = 1 residual from `p`.
@@ -632,27 +499,6 @@ mod tests {
     use crate::model::shooting::ShootingSolution;
     use crate::solve::continuum::shooting::refine_shooting;
 
-    /// An equation that depends on s (as natural strains varying along the
-    /// rod make the rod's): y' = (8 s⁷, cos s), integrated to 1e-12 in a few
-    /// steps. The crate's DOP853 evaluated its 12th stage at the step's start
-    /// (vendor/ode_solvers, c12 fixed): this took hundreds of steps or
-    /// stopped as "stiff".
-    #[test]
-    fn an_equation_that_depends_on_s_is_integrated_to_its_tolerance() {
-        let f = |s: f64, _: &SVector<f64, 2>| SVector::<f64, 2>::new(8.0 * s.powi(7), s.cos());
-        let (end, dense, steps) = integrate(SVector::<f64, 2>::zeros(), f, 1e-12, 5).unwrap();
-        assert!((end[0] - 1.0).abs() < 1e-12, "{}", end[0] - 1.0);
-        assert!(
-            (end[1] - 1f64.sin()).abs() < 1e-12,
-            "{}",
-            end[1] - 1f64.sin()
-        );
-        assert!(steps < 40, "{steps} steps");
-        // the dense output at s = 0.5 too
-        assert!((dense[2][0] - 0.5f64.powi(8)).abs() < 1e-10);
-        assert!((dense[2][1] - 0.5f64.sin()).abs() < 1e-10);
-    }
-
     fn appendix_d() -> (Continuum, Unknowns) {
         let clamps = Clamps::new(0.115, 0.05, 0.802);
         let c = Continuum {
@@ -667,8 +513,9 @@ mod tests {
     }
 
     #[test]
-    fn the_adaptive_solution_is_the_fine_rk4_one() {
-        // the same problem by the fixed-step RK4 of shooting.rs at 40 000 steps
+    fn polishing_by_variational_equations_finds_the_reference_shootings_solution() {
+        // the same problem by the reference shooting (Newton with the
+        // Jacobian by central differences of whole integrations)
         let (c, p) = appendix_d();
         let (n, m) = refine_shooting(
             p.fixed_rows::<3>(0).into(),
@@ -676,19 +523,20 @@ mod tests {
             3.0,
             3.0,
             &c.clamps,
-            40_000,
         )
         .unwrap();
         let polished = c.polish(&p).unwrap();
-        let rk4 = Unknowns::new(n[0], n[1], n[2], m[0], m[1], m[2]);
+        let reference = Unknowns::new(n[0], n[1], n[2], m[0], m[1], m[2]);
         assert!(polished.residual < NEWTON_TOL);
         assert!(
-            (polished.unknowns - rk4).norm() < 1e-7 * rk4.norm(),
+            (polished.unknowns - reference).norm() < 1e-9 * reference.norm(),
             "{} vs {}",
             polished.unknowns,
-            rk4
+            reference
         );
-        let tw = ShootingSolution::integrate(n, m, 3.0, 3.0, 40_000).twist();
+        let tw = ShootingSolution::integrate(n, m, 3.0, 3.0, 1)
+            .unwrap()
+            .twist();
         let sol = c.solve(&polished.unknowns, 0).unwrap();
         assert!((sol.twist - tw).abs() < 1e-10, "{} vs {tw}", sol.twist);
     }

@@ -1,24 +1,24 @@
-//! Newton shooting of the reference RK4 solutions (`model::shooting`,
+//! Newton shooting of the reference solutions (`model::shooting`,
 //! `model::strip_shooting`): the paper's own method, used to make references
 //! and the `[initial] shape = "shooting"` start, never in the rod solver.
 
 use crate::model::natural::NaturalStrains;
 use crate::model::rod::Clamps;
-use crate::model::shooting::ShootingSolution;
+use crate::model::shooting::shooting_residual;
 use crate::model::strip_shooting::{StripProblem, StripShootingError, StripUnknowns};
 use crate::solve::continuum::newton::{NewtonShootingFailure, central_jacobian, newton_shooting};
 use nalgebra::{Vector3, Vector6};
 
 /// Refine published shooting data (n(0), m(0)) by Newton's method on the six
-/// boundary conditions at s = 1 (Jacobian by central differences: this is the
-/// paper's own method, used only to make a reference, never in the rod solver).
+/// boundary conditions at s = 1 to a residual below 1e-11 (Jacobian by
+/// central differences: this is the paper's own method, used only to make a
+/// reference, never in the rod solver).
 pub fn refine_shooting(
     n0: Vector3<f64>,
     m0: Vector3<f64>,
     k2: f64,
     k3: f64,
     clamps: &Clamps,
-    steps: usize,
 ) -> Option<(Vector3<f64>, Vector3<f64>)> {
     refine_shooting_loaded(
         n0,
@@ -27,7 +27,6 @@ pub fn refine_shooting(
         k3,
         (Vector3::zeros(), &NaturalStrains::default()),
         clamps,
-        steps,
     )
 }
 
@@ -40,29 +39,22 @@ pub fn refine_shooting_loaded(
     k3: f64,
     (weight, natural): (Vector3<f64>, &NaturalStrains),
     clamps: &Clamps,
-    steps: usize,
 ) -> Option<(Vector3<f64>, Vector3<f64>)> {
-    let mut p = Vector6::new(n0[0], n0[1], n0[2], m0[0], m0[1], m0[2]);
+    let start = Vector6::new(n0[0], n0[1], n0[2], m0[0], m0[1], m0[2]);
+    // a start the equations cannot be integrated from has no residual:
+    // Newton counts it as a failed step
     let res = |p: &Vector6<f64>| {
-        ShootingSolution::integrate_from(
+        shooting_residual(
             clamps,
             p.fixed_rows::<3>(0).into(),
             p.fixed_rows::<3>(3).into(),
             [k2, k3],
-            (weight, natural.clone()),
-            steps,
+            (weight, natural),
         )
-        .boundary_residual(clamps)
+        .unwrap_or_else(|_| Vector6::repeat(f64::NAN))
     };
-    for _ in 0..30 {
-        let r = res(&p);
-        if r.norm() < 1e-11 {
-            return Some((p.fixed_rows::<3>(0).into(), p.fixed_rows::<3>(3).into()));
-        }
-        let dp = central_jacobian(&p, res).lu().solve(&(-r))?;
-        p += dp;
-    }
-    None
+    let (p, _, _) = newton_shooting(start, res, |q| central_jacobian(q, res), 1e-11, 30, 0).ok()?;
+    Some((p.fixed_rows::<3>(0).into(), p.fixed_rows::<3>(3).into()))
 }
 
 impl StripProblem {
@@ -70,7 +62,12 @@ impl StripProblem {
     /// central differences, as for the rod: a reference, not a solver), to a
     /// residual below 1e-11.
     pub fn refine(&self, start: StripUnknowns) -> Result<StripUnknowns, StripShootingError> {
-        let res = |p: &Vector6<f64>| self.residual(&StripUnknowns::from_vector(p));
+        self.residual(&start)?;
+        // a step the equations cannot be integrated from is a failed step
+        let res = |p: &Vector6<f64>| {
+            self.residual(&StripUnknowns::from_vector(p))
+                .unwrap_or_else(|_| Vector6::repeat(f64::NAN))
+        };
         match newton_shooting(
             start.to_vector(),
             res,

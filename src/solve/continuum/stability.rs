@@ -10,11 +10,10 @@
 //! det B(s) — in (0, 1). The count brackets each eigenvalue, regula falsi on
 //! D refines it, and the same at a 100 times looser tolerance is its error.
 
+use crate::model::ode::integrate_stops;
 use crate::model::rod::EndKind;
 use crate::model::strip_shooting::{StripOdeState, strip_rhs};
-use crate::solve::continuum::{
-    Continuum, ContinuumError, ContinuumLaw, Unknowns, VARIATIONAL, integrate_stops,
-};
+use crate::solve::continuum::{Continuum, ContinuumError, ContinuumLaw, Unknowns, VARIATIONAL};
 use nalgebra::{Matrix6, SVector, Vector3};
 
 /// Samples of det B(s) in (0, 1] counted for sign changes.
