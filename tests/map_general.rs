@@ -67,7 +67,7 @@ fn crossings_at_interval_ends(map: &Map, tol: f64) -> usize {
             assert!(
                 d < tol,
                 "{} = {}: the walk crosses at {c}, {d} from the grid's ends {ends:?}",
-                map.parameter,
+                map.parameter.name(),
                 l.value
             );
             cuts += 1;
@@ -93,12 +93,15 @@ fn map_in_z_star_and_end_tilt_agrees_with_the_tilt_branch_and_the_walk() {
         ],
     );
     assert_eq!(
-        (map.parameter.as_str(), map.along.as_str()),
+        (map.parameter.name(), map.along.name()),
         ("z_star", "end_tilt")
     );
     assert_eq!(map.grid_along.len(), 21);
     assert_eq!(map.grid_along[0], -0.1);
-    assert!(map.bounding_box.contains_key("end_tilt") && map.bounding_box.contains_key("z_star"));
+    assert!(
+        map.bounding_box.contains_key(&Parameter::EndTilt)
+            && map.bounding_box.contains_key(&Parameter::ZStar)
+    );
 
     // every good interval is one tilt interval bounded by the walls: W1
     // below (the good side above it, as in φ), W2 above
@@ -204,7 +207,7 @@ fn map_files_written_in_phi_still_load() {
                    "grid_check": {"ends": 2, "max_phi_deviation": 1e-5, "lines_with_other_count": []}}
     }"#;
     let map: Map = serde_json::from_str(old).unwrap();
-    assert_eq!(map.along, "phi_over_2pi");
+    assert_eq!(map.along, Parameter::Phi);
     assert_eq!(map.grid_along, [0.8]);
     assert_eq!(map.lines[0].points[0].along, 0.8);
     let g = map.traced.unwrap().grid_check.unwrap();
@@ -244,7 +247,7 @@ fn a_map_whose_lines_run_in_a_model_scalar_places_them_by_it() {
             ("grid_columns = 91", "grid_columns = 21"),
         ],
     );
-    assert_eq!(map.along, "K3");
+    assert_eq!(map.along, Parameter::K3);
     // z* = 0.10 lies left of the region; 0.115 (the walk's start, K3 = 3),
     // 0.13 and 0.145 cross it
     for l in &map.lines {

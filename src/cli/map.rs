@@ -3,7 +3,6 @@
 use super::progress::Progress;
 use crate::io::json::write_pretty;
 use crate::io::map_files::{LineFolder, Partial, merge as merge_parts, trace_cached};
-use crate::io::plot::axis_label;
 use crate::scene::MapSpec;
 use crate::scene::{Job, Scene};
 use crate::study::boundary::Traced;
@@ -81,7 +80,13 @@ fn print_map3(name: &str, map3: &Map3, json: &Path) -> Result<()> {
     let mut out = std::io::stdout().lock();
     writeln!(out, "3D map of {name}: good volume {:.6}", map3.good_volume)?;
     for (k, v) in &map3.bounding_box {
-        writeln!(out, "  good knots for {k} in [{:.5}, {:.5}]", v[0], v[1])?;
+        writeln!(
+            out,
+            "  good knots for {} in [{:.5}, {:.5}]",
+            k.name(),
+            v[0],
+            v[1]
+        )?;
     }
     for ((v, a), t) in map3
         .slice_values
@@ -92,7 +97,7 @@ fn print_map3(name: &str, map3: &Map3, json: &Path) -> Result<()> {
         writeln!(
             out,
             "  {} = {v}: good area {a:.6}, traced {}",
-            map3.slice_parameter,
+            map3.slice_parameter.name(),
             t.map_or("—".to_string(), |t| format!("{t:.6}"))
         )?;
     }
@@ -208,7 +213,7 @@ fn write_map(map: &Map, json: &Path) -> Result<()> {
 
 /// The map's region line by line, and its traced boundary.
 fn print_map(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
-    let (swept, along) = (axis_label(&map.parameter), axis_label(&map.along));
+    let (swept, along) = (map.parameter.symbol(), map.along.symbol());
     writeln!(
         out,
         "map of {} over {} lines of {along}: good area {:.6} in ({swept}, {along})",
@@ -217,14 +222,20 @@ fn print_map(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
         map.good_area,
     )?;
     for (k, v) in &map.bounding_box {
-        writeln!(out, "  good knots for {k} in [{:.5}, {:.5}]", v[0], v[1])?;
+        writeln!(
+            out,
+            "  good knots for {} in [{:.5}, {:.5}]",
+            k.name(),
+            v[0],
+            v[1]
+        )?;
     }
     for l in &map.lines {
         let iv: Vec<String> = l.intervals.iter().map(|i| i.to_string()).collect();
         writeln!(
             out,
             "  {} = {:.4}: {}{}",
-            map.parameter,
+            map.parameter.name(),
             l.value,
             if iv.is_empty() {
                 "no good knots".into()
@@ -271,14 +282,14 @@ fn print_traced(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
         writeln!(out, "  enclosed area {a:.6} (grid: {:.6})", map.good_area)?;
     }
     for (k, v) in &t.bounding_box {
-        writeln!(out, "  traced {k} in [{:.5}, {:.5}]", v[0], v[1])?;
+        writeln!(out, "  traced {} in [{:.5}, {:.5}]", k.name(), v[0], v[1])?;
     }
     if let Some(g) = &t.grid_check {
         writeln!(
             out,
             "  grid check: {} interval ends, largest {} deviation {:.2e}, lines counting other ends: {:?}",
             g.ends,
-            axis_label(&map.along),
+            map.along.symbol(),
             g.max_deviation,
             g.lines_with_other_count
         )?;

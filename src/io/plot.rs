@@ -356,17 +356,6 @@ where
     root.present().map_err(err)
 }
 
-/// A map axis's label: a parameter's name as the paper writes it where it
-/// has a symbol (φ/2π, z*, δ), else its name in scenes.
-pub fn axis_label(name: &str) -> &str {
-    match name {
-        "phi_over_2pi" => "φ/2π",
-        "z_star" => "z*",
-        "delta" => "δ",
-        other => other,
-    }
-}
-
 fn draw_map<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     map: &crate::study::map::Map,
@@ -388,8 +377,8 @@ where
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc(axis_label(&map.along))
-        .y_desc(axis_label(&map.parameter))
+        .x_desc(map.along.symbol())
+        .y_desc(map.parameter.symbol())
         .draw()
         .map_err(err)?;
     for (row, l) in map.grid.iter().zip(&map.lines) {

@@ -1561,4 +1561,67 @@ impl Parameter {
             Parameter::NaturalScale => "natural_scale",
         }
     }
+
+    /// The symbol a figure's axis carries (the paper's: φ/2π, z*, δ).
+    pub fn symbol(&self) -> &'static str {
+        match self {
+            Parameter::Phi => "φ/2π",
+            Parameter::ZStar => "z*",
+            Parameter::Delta => "δ",
+            other => other.name(),
+        }
+    }
+}
+
+/// Serde of a [`Parameter`] by its scene name ([`Parameter::name`]), the
+/// spelling of map files (`#[serde(with = "parameter_by_name")]`).
+pub mod parameter_by_name {
+    use super::Parameter;
+    use serde::{Deserialize, Deserializer, Serializer, de::Error};
+
+    /// Write the parameter's name.
+    pub fn serialize<S: Serializer>(p: &Parameter, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(p.name())
+    }
+
+    /// Read a parameter from its name.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Parameter, D::Error> {
+        let name = String::deserialize(d)?;
+        Parameter::named(&name)
+            .ok_or_else(|| D::Error::custom(format!("unknown parameter {name:?}")))
+    }
+}
+
+/// Ranges keyed by parameter, written keyed by the parameters' names (a
+/// bounding box in map files: `#[serde(with = "ranges_by_name")]`).
+pub mod ranges_by_name {
+    use super::Parameter;
+    use serde::{Deserialize, Deserializer, Serializer, de::Error, ser::SerializeMap};
+    use std::collections::BTreeMap;
+
+    /// Write {name: [lo, hi]}.
+    pub fn serialize<S: Serializer>(
+        ranges: &BTreeMap<Parameter, [f64; 2]>,
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(Some(ranges.len()))?;
+        for (p, r) in ranges {
+            map.serialize_entry(p.name(), r)?;
+        }
+        map.end()
+    }
+
+    /// Read {name: [lo, hi]}.
+    pub fn deserialize<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<BTreeMap<Parameter, [f64; 2]>, D::Error> {
+        BTreeMap::<String, [f64; 2]>::deserialize(d)?
+            .into_iter()
+            .map(|(name, r)| {
+                Parameter::named(&name)
+                    .map(|p| (p, r))
+                    .ok_or_else(|| D::Error::custom(format!("unknown parameter {name:?}")))
+            })
+            .collect()
+    }
 }

@@ -10,7 +10,7 @@
 use crate::analysis::class::Class;
 use crate::analysis::equilibrium::{Equilibrium, Measure};
 use crate::analysis::event::{Event, EventKind};
-use crate::model::rod::Parameter;
+use crate::model::rod::{Parameter, parameter_by_name, ranges_by_name};
 use crate::scene::{MapSpec, Scene, SliceSpec};
 use crate::study::boundary::{GridCheck, Traced};
 use crate::study::branch::{BranchOptions, BranchRun};
@@ -79,10 +79,11 @@ pub struct Map {
     /// Scene name.
     pub scene: String,
     /// The swept parameter (the map's vertical axis).
-    pub parameter: String,
+    #[serde(with = "parameter_by_name")]
+    pub parameter: Parameter,
     /// The parameter along each line (the continuation's: the horizontal axis).
-    #[serde(default = "phi_name")]
-    pub along: String,
+    #[serde(default = "phi", with = "parameter_by_name")]
+    pub along: Parameter,
     /// Lines, by increasing index.
     pub lines: Vec<Line>,
     /// Named boundary curves, (swept value, value along) points: the traced
@@ -101,14 +102,15 @@ pub struct Map {
     pub grid_along: Vec<f64>,
     /// Area of the good region in the (swept, along) plane.
     pub good_area: f64,
-    /// {swept: [lo, hi], along: [lo, hi]} of the good region, keyed by the
-    /// parameters' names.
-    pub bounding_box: BTreeMap<String, [f64; 2]>,
+    /// {swept: [lo, hi], along: [lo, hi]} of the good region (written keyed
+    /// by the parameters' names).
+    #[serde(with = "ranges_by_name")]
+    pub bounding_box: BTreeMap<Parameter, [f64; 2]>,
 }
 
 /// Maps written before maps took any parameter along their lines ran in φ.
-fn phi_name() -> String {
-    Parameter::Phi.name().into()
+fn phi() -> Parameter {
+    Parameter::Phi
 }
 
 /// A 3D map: its slices and the good region's volume and bounding box.
@@ -117,9 +119,11 @@ pub struct Map3 {
     /// Scene name.
     pub scene: String,
     /// The slicing parameter.
-    pub slice_parameter: String,
+    #[serde(with = "parameter_by_name")]
+    pub slice_parameter: Parameter,
     /// The swept parameter of each slice.
-    pub parameter: String,
+    #[serde(with = "parameter_by_name")]
+    pub parameter: Parameter,
     /// Slice values.
     pub slice_values: Vec<f64>,
     /// Good area of each slice.
@@ -128,7 +132,8 @@ pub struct Map3 {
     /// the slices).
     pub good_volume: f64,
     /// Bounding box of the good region over all slices.
-    pub bounding_box: BTreeMap<String, [f64; 2]>,
+    #[serde(with = "ranges_by_name")]
+    pub bounding_box: BTreeMap<Parameter, [f64; 2]>,
     /// Area enclosed by each slice's traced boundary (None: not closed).
     #[serde(default)]
     pub traced_areas: Vec<Option<f64>>,
@@ -145,27 +150,24 @@ pub fn assemble_3d(scene: &str, spec: &SliceSpec, slices: Vec<Map>) -> Map3 {
         .zip(areas.windows(2))
         .map(|(v, a)| 0.5 * (a[0] + a[1]) * (v[1] - v[0]))
         .sum();
-    let mut bounding_box: BTreeMap<String, [f64; 2]> = BTreeMap::new();
+    let mut bounding_box: BTreeMap<Parameter, [f64; 2]> = BTreeMap::new();
     for (m, &v) in slices.iter().zip(&spec.values) {
         if m.bounding_box.is_empty() {
             continue;
         }
-        let mut grow = |k: &str, r: [f64; 2]| {
-            let e = bounding_box.entry(k.to_string()).or_insert(r);
+        let mut grow = |k: Parameter, r: [f64; 2]| {
+            let e = bounding_box.entry(k).or_insert(r);
             *e = [e[0].min(r[0]), e[1].max(r[1])];
         };
-        grow(spec.parameter.name(), [v, v]);
+        grow(spec.parameter, [v, v]);
         for (k, r) in &m.bounding_box {
-            grow(k, *r);
+            grow(*k, *r);
         }
     }
     Map3 {
         scene: scene.into(),
-        slice_parameter: spec.parameter.name().into(),
-        parameter: slices
-            .first()
-            .map(|m| m.parameter.clone())
-            .unwrap_or_default(),
+        slice_parameter: spec.parameter,
+        parameter: slices.first().map_or(spec.parameter, |m| m.parameter),
         slice_values: spec.values.clone(),
         slice_areas: areas,
         good_volume: volume,
@@ -487,13 +489,13 @@ pub fn assemble(
     };
     let mut bounding_box = BTreeMap::new();
     if vlo.is_finite() {
-        bounding_box.insert(spec.parameter.name().to_string(), [vlo, vhi]);
-        bounding_box.insert(along.name().to_string(), [alo, ahi]);
+        bounding_box.insert(spec.parameter, [vlo, vhi]);
+        bounding_box.insert(along, [alo, ahi]);
     }
     Map {
         scene: scene_name.into(),
-        parameter: spec.parameter.name().into(),
-        along: along.name().into(),
+        parameter: spec.parameter,
+        along,
         lines,
         boundaries,
         grid_boundaries,

@@ -139,7 +139,7 @@ fn shooting(init: &InitialSpec, model: &RodModel, clamps: Clamps) -> Result<RodS
         (weight, natural.clone()),
         intervals,
     )
-    .context("initial: integrating the shooting data")?;
+    .context("initial.n0, initial.m0: integrating the shooting data")?;
     Ok(RodState::from_curve(
         model.segments,
         clamps,
@@ -180,7 +180,7 @@ fn strip_shooting(
     }
     let sol = problem
         .integrate(&p)
-        .context("initial: integrating the strip's shooting data")?;
+        .context("initial.n0, initial.u1_0, initial.m2_0, initial.u3_0: integrating the strip's shooting data")?;
     Ok(RodState::from_curve(
         model.segments,
         clamps,

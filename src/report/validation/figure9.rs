@@ -36,18 +36,18 @@ fn map3_table(scenes: &Path) -> Result<String> {
     )?;
     s += &slice_table(&m3)?;
     s += &highest_slice(&scene, &slices, &m3)?;
-    let b = |k: &str| {
+    let b = |k: Parameter| {
         m3.bounding_box
-            .get(k)
+            .get(&k)
             .map_or("—".to_string(), |b| format!("[{:.3}, {:.3}]", b[0], b[1]))
     };
     writeln!(
         s,
         "\nGood volume {:.5} in (δ, z*, φ/2π); bounding box δ {}, z* {}, φ/2π {}. The paper: no good knots outside 0.01 < δ < 0.3, 0.05 < z* < 0.45, 0.02 < 1 − φ/2π < 0.5.",
         m3.good_volume,
-        b("delta"),
-        b("z_star"),
-        b("phi_over_2pi")
+        b(Parameter::Delta),
+        b(Parameter::ZStar),
+        b(Parameter::Phi)
     )?;
     Ok(s)
 }
@@ -101,16 +101,16 @@ fn slice_table(m3: &Map3) -> Result<String> {
         "| δ | good area (grid) | z* range | φ/2π range | traced boundary: area, z* range, φ/2π range | largest φ/2π gap to the grid's ends |\n|---|---|---|---|---|---|"
     )?;
     for (m, v) in m3.slices.iter().zip(&m3.slice_values) {
-        let r = |b: &std::collections::BTreeMap<String, [f64; 2]>, k: &str| {
-            b.get(k)
+        let r = |b: &std::collections::BTreeMap<Parameter, [f64; 2]>, k: Parameter| {
+            b.get(&k)
                 .map_or("—".to_string(), |b| format!("[{:.3}, {:.3}]", b[0], b[1]))
         };
         let traced = match &m.traced {
             Some(t) if t.closed => format!(
                 "{:.5}, {}, {}",
                 t.area.unwrap_or(f64::NAN),
-                r(&t.bounding_box, "z_star"),
-                r(&t.bounding_box, "phi_over_2pi")
+                r(&t.bounding_box, Parameter::ZStar),
+                r(&t.bounding_box, Parameter::Phi)
             ),
             Some(t) => format!("open: {}", t.stopped.as_deref().unwrap_or("?")),
             None => "—".to_string(),
@@ -126,8 +126,8 @@ fn slice_table(m3: &Map3) -> Result<String> {
             s,
             "| {v} | {:.5} | {} | {} | {traced} | {gap} |",
             m.good_area,
-            r(&m.bounding_box, "z_star"),
-            r(&m.bounding_box, "phi_over_2pi")
+            r(&m.bounding_box, Parameter::ZStar),
+            r(&m.bounding_box, Parameter::Phi)
         )?;
     }
     Ok(s)
@@ -142,7 +142,7 @@ fn highest_slice(scene: &Scene, slices: &SliceSpec, m3: &Map3) -> Result<String>
         .enumerate()
         .filter_map(|(k, m)| {
             let t = m.traced.as_ref().filter(|t| t.closed)?;
-            Some((k, t.bounding_box.get("z_star")?[1]))
+            Some((k, t.bounding_box.get(&Parameter::ZStar)?[1]))
         })
         .max_by(|a, b| a.1.total_cmp(&b.1));
     if let Some((k, zmax)) = top {
@@ -152,7 +152,7 @@ fn highest_slice(scene: &Scene, slices: &SliceSpec, m3: &Map3) -> Result<String>
         let t = crate::study::boundary::trace_island(&slice, &sspec, Some(n), &|_, _| {})?;
         let fine = t
             .bounding_box
-            .get("z_star")
+            .get(&Parameter::ZStar)
             .map_or("—".to_string(), |b| format!("{:.4}", b[1]));
         writeln!(
             s,

@@ -121,11 +121,11 @@ fn grid_table(scene: &Scene, spec: &MapSpec, map: &Map, name: &str) -> Result<St
     writeln!(
         s,
         "\nGood knots for z* in [{:.3}, {:.3}] (lines {:.3} apart) and φ/2π in [{:.4}, {:.4}]; area {:.5} in the (z*, φ/2π) plane. Boundaries met: {}.",
-        bb.get("z_star").map_or(f64::NAN, |v| v[0]),
-        bb.get("z_star").map_or(f64::NAN, |v| v[1]),
+        bb.get(&Parameter::ZStar).map_or(f64::NAN, |v| v[0]),
+        bb.get(&Parameter::ZStar).map_or(f64::NAN, |v| v[1]),
         spec.value(1) - spec.value(0),
-        bb.get("phi_over_2pi").map_or(f64::NAN, |v| v[0]),
-        bb.get("phi_over_2pi").map_or(f64::NAN, |v| v[1]),
+        bb.get(&Parameter::Phi).map_or(f64::NAN, |v| v[0]),
+        bb.get(&Parameter::Phi).map_or(f64::NAN, |v| v[1]),
         map.good_area,
         map.grid_boundaries
             .keys()
@@ -295,14 +295,14 @@ fn traced_table(t: &Traced) -> Result<String> {
 fn traced_extent(t: &Traced) -> Result<String> {
     let mut s = String::new();
     let bb = &t.bounding_box;
-    let range = |k: &str| bb.get(k).copied().unwrap_or([f64::NAN; 2]);
+    let range = |k: Parameter| bb.get(&k).copied().unwrap_or([f64::NAN; 2]);
     writeln!(
         s,
         "\nTraced extent: z* in [{:.4}, {:.4}], φ/2π in [{:.4}, {:.4}]; enclosed area {}.",
-        range("z_star")[0],
-        range("z_star")[1],
-        range("phi_over_2pi")[0],
-        range("phi_over_2pi")[1],
+        range(Parameter::ZStar)[0],
+        range(Parameter::ZStar)[1],
+        range(Parameter::Phi)[0],
+        range(Parameter::Phi)[1],
         t.area.map_or("—".to_string(), |a| format!("{a:.5}"))
     )?;
     if let Some(g) = &t.grid_check {

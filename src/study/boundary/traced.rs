@@ -1,7 +1,7 @@
 //! The traced boundary: the walk's pieces named as the paper does (W1, W2,
 //! X1, X2, S), the loop's area and extent.
 
-use crate::model::rod::{Parameter, RodState};
+use crate::model::rod::{Parameter, RodState, ranges_by_name};
 use crate::study::boundary::condition::Condition;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -102,9 +102,10 @@ pub struct Traced {
     pub closed: bool,
     /// Area enclosed (closed walks only).
     pub area: Option<f64>,
-    /// Extent of the traced boundary: {swept: [lo, hi], along: [lo, hi]},
-    /// keyed by the parameters' names.
-    pub bounding_box: BTreeMap<String, [f64; 2]>,
+    /// Extent of the traced boundary: {swept: [lo, hi], along: [lo, hi]}
+    /// (written keyed by the parameters' names).
+    #[serde(with = "ranges_by_name")]
+    pub bounding_box: BTreeMap<Parameter, [f64; 2]>,
     /// Points of the pieces (a corner counts in both its pieces).
     pub points: usize,
     /// Equilibria solved (Newton at fixed clamps).
@@ -271,10 +272,10 @@ pub(super) fn name_pieces(
             .abs()
     });
     if !all.is_empty() {
-        for (k, name) in [swept.name(), along.name()].into_iter().enumerate() {
+        for (k, name) in [swept, along].into_iter().enumerate() {
             let lo = all.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
             let hi = all.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
-            traced.bounding_box.insert(name.to_string(), [lo, hi]);
+            traced.bounding_box.insert(name, [lo, hi]);
         }
     }
     traced
@@ -318,7 +319,7 @@ mod tests {
         // the start) only when they share a name; here S closes the loop
         assert_eq!(labels, ["W2", "W1", "S"]);
         assert_eq!(t.pieces[0].points, vec![[0.2, 0.9], [0.1, 0.8], [0.1, 0.7]]);
-        assert_eq!(t.bounding_box["z_star"], [0.1, 0.3]);
+        assert_eq!(t.bounding_box[&Parameter::ZStar], [0.1, 0.3]);
         // shoelace area of the polygon (0.2,0.9) (0.1,0.8) (0.1,0.7) (0.2,0.6) (0.3,0.8)
         assert!((t.area.unwrap() - 0.035).abs() < 1e-12, "{:?}", t.area);
         assert_eq!(t.equilibria, 7);
