@@ -75,11 +75,12 @@ pub fn merge(parts: &[PathBuf], json: &Path) -> Result<()> {
     write_map(&map, json)
 }
 
-/// Print a 3D map, draw its slices and say where it was written.
-fn print_map3(name: &str, map3: &Map3, json: &Path) -> Result<()> {
-    let mut out = std::io::stdout().lock();
-    writeln!(out, "3D map of {name}: good volume {:.6}", map3.good_volume)?;
-    for (k, v) in &map3.bounding_box {
+/// "good knots for z_star in [lo, hi]", one line per parameter.
+fn print_good_ranges(
+    out: &mut impl Write,
+    ranges: &std::collections::BTreeMap<crate::model::rod::Parameter, [f64; 2]>,
+) -> std::io::Result<()> {
+    for (k, v) in ranges {
         writeln!(
             out,
             "  good knots for {} in [{:.5}, {:.5}]",
@@ -88,6 +89,14 @@ fn print_map3(name: &str, map3: &Map3, json: &Path) -> Result<()> {
             v[1]
         )?;
     }
+    Ok(())
+}
+
+/// Print a 3D map, draw its slices and say where it was written.
+fn print_map3(name: &str, map3: &Map3, json: &Path) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "3D map of {name}: good volume {:.6}", map3.good_volume)?;
+    print_good_ranges(&mut out, &map3.bounding_box)?;
     for ((v, a), t) in map3
         .slice_values
         .iter()
@@ -221,15 +230,7 @@ fn print_map(map: &Map, out: &mut impl Write) -> std::io::Result<()> {
         map.lines.len(),
         map.good_area,
     )?;
-    for (k, v) in &map.bounding_box {
-        writeln!(
-            out,
-            "  good knots for {} in [{:.5}, {:.5}]",
-            k.name(),
-            v[0],
-            v[1]
-        )?;
-    }
+    print_good_ranges(out, &map.bounding_box)?;
     for l in &map.lines {
         let iv: Vec<String> = l.intervals.iter().map(|i| i.to_string()).collect();
         writeln!(
