@@ -26,6 +26,9 @@ pub struct Spectrum {
     /// Eigenvectors (on the free dofs) of `values`, in the same order.
     #[serde(skip)]
     pub vectors: Vec<Vec<f64>>,
+    /// The shift σ of the shift-invert iteration (below the lowest eigenvalue).
+    #[serde(skip)]
+    pub shift: f64,
 }
 
 /// Stability analysis failed.
@@ -361,22 +364,19 @@ fn lowest_with(
         // singular at 0: count at a tiny negative shift (zero modes are not negative)
         None => count(-1e-12 * diag_scale, ldlt, &mut work).ok_or(StabilityError::NoShift)?,
     };
-    // σ strictly below the lowest eigenvalue
-    let mut sigma = if negative_count == 0 {
-        0.0
-    } else {
-        -1e-8 * diag_scale
-    };
+    // σ strictly below the lowest eigenvalue and within a factor 4 of it:
+    // grown ×4 from 1e-14 of the largest diagonal, far below any eigenvalue
+    // that matters, so that σ never sits far below a negative λ₁ near zero
+    // (starting at 1e-8 of it, σ = −92 for λ₁ ≈ −0.01, λ₂ ≈ 0.02 at N = 800
+    // made μ₁ ≈ μ₂, and Lanczos restarted 20 times: the branch's N⁵)
+    let first = -1e-14 * diag_scale;
+    let mut sigma = if negative_count == 0 { 0.0 } else { first };
     loop {
         match count(sigma, ldlt, &mut work) {
             Some(0) if sigma < 0.0 || negative_count == 0 => break,
             _ => {}
         }
-        sigma = if sigma == 0.0 {
-            -1e-8 * diag_scale
-        } else {
-            sigma * 4.0
-        };
+        sigma = if sigma == 0.0 { first } else { sigma * 4.0 };
         if sigma < -1e3 * diag_scale {
             return Err(StabilityError::NoShift);
         }
@@ -394,6 +394,7 @@ fn lowest_with(
     if k == 0 {
         return Ok(Spectrum {
             negative_count,
+            shift: sigma,
             ..Default::default()
         });
     }
@@ -482,6 +483,7 @@ fn lowest_with(
         values: modes.iter().map(|m| m.0).collect(),
         vectors: modes.into_iter().map(|m| m.1).collect(),
         negative_count,
+        shift: sigma,
     })
 }
 
@@ -563,4 +565,48 @@ fn rayleigh_ritz(
         .collect();
     pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
     Ok(Some(pairs))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A negative lowest eigenvalue near zero beside large ones (a stiff rod
+    /// near a loss of stability): the shift lies within a factor 4 below it,
+    /// not at a fraction of the largest diagonal (−100 here, where μ₁ ≈ μ₂
+    /// and Lanczos restarted without end on the rod).
+    #[test]
+    fn the_shift_is_near_a_small_negative_lowest_eigenvalue() {
+        let n = 300;
+        let stencils: Vec<Vec<Option<usize>>> =
+            (0..n - 1).map(|i| vec![Some(i), Some(i + 1)]).collect();
+        let pattern = SymmetricPattern::from_stencils(n, &stencils);
+        let mut values = vec![0.0; pattern.nnz()];
+        for i in 0..n {
+            let d = match i {
+                0 => -0.01,
+                1 => 0.02,
+                _ => 1e10 * (1.0 + i as f64 / n as f64),
+            };
+            values[pattern.slot(i, i).unwrap()] = d;
+        }
+        let mut ldlt = Ldlt::new(&pattern);
+        let spectrum = lowest_eigenvalues(&pattern, &values, None, 2, &mut ldlt).unwrap();
+        assert_eq!(spectrum.negative_count, 1);
+        assert!(
+            spectrum.shift < -0.01 && spectrum.shift >= -0.04,
+            "shift {}",
+            spectrum.shift
+        );
+        assert!(
+            (spectrum.values[0] + 0.01).abs() < 1e-12,
+            "{:?}",
+            spectrum.values
+        );
+        assert!(
+            (spectrum.values[1] - 0.02).abs() < 1e-12,
+            "{:?}",
+            spectrum.values
+        );
+    }
 }
