@@ -365,11 +365,12 @@ fn lowest_with(
         None => count(-1e-12 * diag_scale, ldlt, &mut work).ok_or(StabilityError::NoShift)?,
     };
     // σ strictly below the lowest eigenvalue and within a factor 4 of it:
-    // grown ×4 from 1e-14 of the largest diagonal, far below any eigenvalue
-    // that matters, so that σ never sits far below a negative λ₁ near zero
-    // (starting at 1e-8 of it, σ = −92 for λ₁ ≈ −0.01, λ₂ ≈ 0.02 at N = 800
-    // made μ₁ ≈ μ₂, and Lanczos restarted 20 times: the branch's N⁵)
-    let first = -1e-14 * diag_scale;
+    // grown ×4 from 1e-8 of the largest diagonal until below it, and where
+    // that first σ is already below, moved up ×4 (down to 1e-14 of it) while
+    // it stays below. A σ far below a negative λ₁ near zero (σ = −92 for
+    // λ₁ ≈ −0.01, λ₂ ≈ 0.02 at N = 800) makes μ₁ ≈ μ₂, and Lanczos restarted
+    // 20 times there: the branch's N⁵.
+    let first = -1e-8 * diag_scale;
     let mut sigma = if negative_count == 0 { 0.0 } else { first };
     loop {
         match count(sigma, ldlt, &mut work) {
@@ -379,6 +380,18 @@ fn lowest_with(
         sigma = if sigma == 0.0 { first } else { sigma * 4.0 };
         if sigma < -1e3 * diag_scale {
             return Err(StabilityError::NoShift);
+        }
+    }
+    if sigma == first {
+        let mut moved = false;
+        while sigma / 4.0 <= -1e-14 * diag_scale && count(sigma / 4.0, ldlt, &mut work) == Some(0) {
+            sigma /= 4.0;
+            moved = true;
+        }
+        // the factorisation is of the last σ tried: of σ again unless that
+        // was the one kept
+        if moved || sigma / 4.0 <= -1e-14 * diag_scale {
+            count(sigma, ldlt, &mut work).ok_or(StabilityError::NoShift)?;
         }
     }
     // reduced space: dofs with mass (all dofs for the plain problem)
