@@ -6,7 +6,7 @@
 
 use knotrod::analysis::event::{Event, EventKind};
 use knotrod::model::natural::NaturalStrains;
-use knotrod::model::shooting::ShootingSolution;
+use knotrod::model::shooting::shooting_residual;
 use knotrod::scene::Scene;
 use knotrod::solve::continuum::Unknowns;
 use knotrod::solve::continuum::branch::{BranchPoint, ContinuumBranch, PARAMETER};
@@ -114,16 +114,14 @@ fn the_polished_branch_point_is_where_a_central_difference_shooting_jacobian_is_
         let c = branch.clamps_at(value);
         let p: Unknowns = z.fixed_rows::<6>(0).into();
         central_jacobian(&p, |q| {
-            ShootingSolution::integrate_from(
+            shooting_residual(
                 &c,
                 q.fixed_rows::<3>(0).into(),
                 q.fixed_rows::<3>(3).into(),
                 [3.0, 3.0],
-                (Vector3::zeros(), NaturalStrains::default()),
-                1,
+                (Vector3::zeros(), &NaturalStrains::default()),
             )
             .unwrap()
-            .boundary_residual(&c)
         })
         .determinant()
     };

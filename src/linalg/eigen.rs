@@ -383,15 +383,14 @@ fn lowest_with(
         }
     }
     if sigma == first {
-        let mut moved = false;
-        while sigma / 4.0 <= -1e-14 * diag_scale && count(sigma / 4.0, ldlt, &mut work) == Some(0) {
-            sigma /= 4.0;
-            moved = true;
-        }
-        // the factorisation is of the last σ tried: of σ again unless that
-        // was the one kept
-        if moved || sigma / 4.0 <= -1e-14 * diag_scale {
-            count(sigma, ldlt, &mut work).ok_or(StabilityError::NoShift)?;
+        while sigma / 4.0 <= -1e-14 * diag_scale {
+            if count(sigma / 4.0, ldlt, &mut work) == Some(0) {
+                sigma /= 4.0;
+            } else {
+                // the workspace holds the factorisation at σ / 4: back to σ
+                count(sigma, ldlt, &mut work).ok_or(StabilityError::NoShift)?;
+                break;
+            }
         }
     }
     // reduced space: dofs with mass (all dofs for the plain problem)
