@@ -134,6 +134,38 @@ pub enum PolishFailure {
         /// The solver's reason.
         message: String,
     },
+    /// A traced boundary has no pieces to polish.
+    NoBoundary,
+    /// Too many of a traced boundary's points failed for its area to mean
+    /// much (more than a tenth).
+    TooManyFailed {
+        /// Points that failed.
+        failed: usize,
+        /// Points in all.
+        of: usize,
+        /// The first failure.
+        first: Box<PolishFailure>,
+    },
+}
+
+impl PolishFailure {
+    /// Read a failure written as data, or as the text earlier versions wrote
+    /// (kept as the continuum's message), so old map files still load.
+    pub fn data_or_text<'de, D>(d: D) -> Result<Option<PolishFailure>, D::Error>
+    where
+        D: serde::Deserializer<'de>,
+    {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Written {
+            Data(PolishFailure),
+            Text(String),
+        }
+        Ok(Option::<Written>::deserialize(d)?.map(|w| match w {
+            Written::Data(f) => f,
+            Written::Text(message) => PolishFailure::Continuum { message },
+        }))
+    }
 }
 
 impl std::fmt::Display for PolishFailure {
@@ -147,6 +179,10 @@ impl std::fmt::Display for PolishFailure {
             ),
             PolishFailure::NoSingularVectors => write!(f, "no singular vectors"),
             PolishFailure::Continuum { message } => write!(f, "{message}"),
+            PolishFailure::NoBoundary => write!(f, "no boundary to polish"),
+            PolishFailure::TooManyFailed { failed, of, first } => {
+                write!(f, "{failed} of {of} points failed, the first: {first}")
+            }
         }
     }
 }

@@ -137,6 +137,12 @@ impl PolishError {
     pub fn failure(&self) -> PolishFailure {
         match self {
             PolishError::Event(f) => f.clone(),
+            PolishError::NoBoundary => PolishFailure::NoBoundary,
+            PolishError::TooManyFailed { failed, of, first } => PolishFailure::TooManyFailed {
+                failed: *failed,
+                of: *of,
+                first: Box::new(first.failure()),
+            },
             e => PolishFailure::Continuum {
                 message: e.to_string(),
             },

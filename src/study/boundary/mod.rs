@@ -28,5 +28,5 @@ mod traced;
 mod walk;
 
 pub use condition::{Condition, OtherStrand, Strands};
-pub use traced::{GridCheck, Piece, PolishedBoundary, PolishedCorner, Traced};
+pub use traced::{DroppedPoint, GridCheck, Piece, PolishedBoundary, PolishedCorner, Traced};
 pub use walk::trace_island;

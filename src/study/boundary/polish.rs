@@ -12,7 +12,7 @@ use crate::model::rod::{Clamps, Parameter, RodModel, RodState};
 use crate::solve::continuum::branch::{BranchPoint, ContinuumBranch, PARAMETER, TestFunction};
 use crate::study::boundary::condition::{Condition, OtherStrand};
 use crate::study::boundary::traced::{
-    Piece, PolishedBoundary, PolishedCorner, Trail, TrailPoint, name_pieces,
+    DroppedPoint, Piece, PolishedBoundary, PolishedCorner, Trail, TrailPoint, name_pieces,
 };
 use crate::study::polish::{
     CornerFailure, PolishError, discrete_unknowns, locate_root, singular_at,
@@ -715,7 +715,7 @@ impl OnPieces<'_> {
 /// The walk's points (other than corners) polished, each with its walk
 /// piece and index; a point that fails is left out, and said so (why, as
 /// text for the map's file), unless more than a tenth fail.
-type WalkPoints = (Vec<(usize, usize)>, Vec<Polished>, Vec<String>);
+type WalkPoints = (Vec<(usize, usize)>, Vec<Polished>, Vec<DroppedPoint>);
 
 impl Plane<'_> {
     /// The points other than corners (where one piece ends and the next
@@ -748,25 +748,28 @@ impl Plane<'_> {
                 Ok(p) => Some(((k, i), p)),
                 Err(e) => {
                     let (c, pts) = &trail[k];
-                    dropped.push(e.at(format!(
-                        "{} at ({:.5}, {:.5})",
-                        c.describe(),
-                        pts[i].at[0],
-                        pts[i].at[1]
-                    )));
+                    dropped.push((c.describe(), pts[i].at, e));
                     None
                 }
             })
             .unzip();
         if dropped.len() * 10 > jobs.len() {
             let failed = dropped.len();
+            let (condition, at, first) = dropped.swap_remove(0);
             return Err(PolishError::TooManyFailed {
                 failed,
                 of: jobs.len() + failed,
-                first: Box::new(dropped.swap_remove(0)),
+                first: Box::new(first.at(format!("{condition} at ({:.5}, {:.5})", at[0], at[1]))),
             });
         }
-        let dropped = dropped.iter().map(ToString::to_string).collect();
+        let dropped = dropped
+            .into_iter()
+            .map(|(condition, at, e)| DroppedPoint {
+                condition,
+                at,
+                why: e.failure(),
+            })
+            .collect();
         Ok((jobs, points, dropped))
     }
 

@@ -1,6 +1,7 @@
 //! The traced boundary: the walk's pieces named as the paper does (W1, W2,
 //! X1, X2, S), the loop's area and extent.
 
+use crate::analysis::event::PolishFailure;
 use crate::model::rod::{Parameter, RodState, ranges_by_name};
 use crate::study::boundary::condition::Condition;
 use serde::{Deserialize, Serialize};
@@ -77,7 +78,54 @@ pub struct PolishedBoundary {
     pub tolerance: f64,
     /// Walk points the polish could not locate (left out, their
     /// neighbours' middle polished instead), and why.
-    pub dropped: Vec<String>,
+    #[serde(default, deserialize_with = "dropped_data_or_text")]
+    pub dropped: Vec<DroppedPoint>,
+}
+
+/// A walk point the boundary's polish left out.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct DroppedPoint {
+    /// The condition of its piece, as the pieces name it.
+    pub condition: String,
+    /// The discrete point (swept parameter, value along).
+    pub at: [f64; 2],
+    /// Why it could not be polished.
+    pub why: PolishFailure,
+}
+
+impl std::fmt::Display for DroppedPoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} at ({:.5}, {:.5}): {}",
+            self.condition, self.at[0], self.at[1], self.why
+        )
+    }
+}
+
+/// Dropped points written as data, or as the lines of text earlier versions
+/// wrote (kept whole as the reason, at an unknown point).
+fn dropped_data_or_text<'de, D>(d: D) -> Result<Vec<DroppedPoint>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Written {
+        Data(DroppedPoint),
+        Text(String),
+    }
+    Ok(Vec::<Written>::deserialize(d)?
+        .into_iter()
+        .map(|w| match w {
+            Written::Data(p) => p,
+            Written::Text(message) => DroppedPoint {
+                condition: String::new(),
+                at: [f64::NAN; 2],
+                why: PolishFailure::Continuum { message },
+            },
+        })
+        .collect())
 }
 
 /// How the traced boundary compares with the grid of one-parameter branches.
@@ -119,8 +167,8 @@ pub struct Traced {
     #[serde(default)]
     pub polished: Option<PolishedBoundary>,
     /// Why the polish failed, if it did.
-    #[serde(default)]
-    pub not_polished: Option<String>,
+    #[serde(default, deserialize_with = "PolishFailure::data_or_text")]
+    pub not_polished: Option<PolishFailure>,
 }
 
 impl Traced {
@@ -323,5 +371,55 @@ mod tests {
         // shoelace area of the polygon (0.2,0.9) (0.1,0.8) (0.1,0.7) (0.2,0.6) (0.3,0.8)
         assert!((t.area.unwrap() - 0.035).abs() < 1e-12, "{:?}", t.area);
         assert_eq!(t.equilibria, 7);
+    }
+
+    #[test]
+    fn polish_failures_are_written_as_data_and_old_text_still_reads() {
+        let mut t = Traced::failed("a test".into());
+        t.not_polished = Some(PolishFailure::TooManyFailed {
+            failed: 3,
+            of: 20,
+            first: Box::new(PolishFailure::NoSingularVectors),
+        });
+        let json = serde_json::to_value(&t).unwrap();
+        assert_eq!(json["not_polished"]["reason"], "too_many_failed");
+        assert_eq!(
+            json["not_polished"]["first"]["reason"],
+            "no_singular_vectors"
+        );
+        let back: Traced = serde_json::from_value(json.clone()).unwrap();
+        assert_eq!(back, t);
+        // a map written before the failures were typed
+        let mut old = json;
+        old["not_polished"] = "the corner's secant steps did not converge".into();
+        let back: Traced = serde_json::from_value(old).unwrap();
+        assert_eq!(
+            back.not_polished,
+            Some(PolishFailure::Continuum {
+                message: "the corner's secant steps did not converge".into()
+            })
+        );
+    }
+
+    #[test]
+    fn a_dropped_point_keeps_its_condition_place_and_reason() {
+        let d = DroppedPoint {
+            condition: "wall".into(),
+            at: [0.17, 0.8],
+            why: PolishFailure::NoSelfApproach,
+        };
+        let json = serde_json::to_value(vec![d.clone()]).unwrap();
+        assert_eq!(json[0]["why"]["reason"], "no_self_approach");
+        let back = dropped_data_or_text(json).unwrap();
+        assert_eq!(back, vec![d.clone()]);
+        assert_eq!(
+            d.to_string(),
+            "wall at (0.17000, 0.80000): no self-approach of the centreline"
+        );
+        let old = serde_json::json!(["wall at (0.1, 0.8): no self-approach"]);
+        let back = dropped_data_or_text(old).unwrap();
+        assert!(
+            matches!(&back[0].why, PolishFailure::Continuum { message } if message.contains("wall at"))
+        );
     }
 }

@@ -464,7 +464,7 @@ pub fn trace_island(
     let mut traced = name_pieces([swept, along], walk.equilibria, pieces, closed, stopped);
     match polished {
         Some(Ok(p)) => traced.polished = Some(p),
-        Some(Err(why)) => traced.not_polished = Some(why.to_string()),
+        Some(Err(why)) => traced.not_polished = Some(why.failure()),
         None => {}
     }
     Ok(traced)
