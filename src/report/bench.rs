@@ -50,6 +50,9 @@ pub struct Report {
     pub exponents: BTreeMap<String, f64>,
     /// Seconds per call, per operation and N.
     pub per_call: BTreeMap<String, Vec<(usize, f64)>>,
+    /// Fitted exponent of the whole Figure 3 branch's time with its
+    /// eigenvalues versus N (N = 200 … 1600).
+    pub branch_exponent: Option<f64>,
 }
 
 fn peak_bytes() -> u64 {
@@ -126,6 +129,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
         })
         .collect();
     Ok(Report {
+        branch_exponent: branch_exponent(&workloads),
         workloads,
         exponents,
         per_call: per,
@@ -187,12 +191,43 @@ fn branch_workloads(d: &Scene, fig3: &Scene) -> Result<Vec<Workload>> {
             .map(|_| ())
             .map_err(Into::into)
     })?);
-    workloads.push(timed("figure_3_branch_with_eigenvalues", 200, || {
-        crate::study::run::run_scene(&main_branch, Some(200), &mut |_| Ok(()))
-            .map(|_| ())
-            .map_err(Into::into)
-    })?);
+    // the same at growing N: the stability along a branch is O(N) per
+    // step (the step count does not change with N)
+    for n in BRANCH_SEGMENTS {
+        workloads.push(timed(BRANCH_WITH_EIGENVALUES, n, || {
+            crate::study::run::run_scene(&main_branch, Some(n), &mut |_| Ok(()))
+                .map(|_| ())
+                .map_err(Into::into)
+        })?);
+    }
     Ok(workloads)
+}
+
+/// The workload of the Figure 3 branch with its two lowest eigenvalues.
+const BRANCH_WITH_EIGENVALUES: &str = "figure_3_branch_with_eigenvalues";
+
+/// The N at which the Figure 3 branch with eigenvalues is timed.
+const BRANCH_SEGMENTS: [usize; 4] = [200, 400, 800, 1600];
+
+/// Fitted exponent of the Figure 3 branch's time with eigenvalues versus N
+/// (least squares of log time on log N over `BRANCH_SEGMENTS`).
+fn branch_exponent(workloads: &[Workload]) -> Option<f64> {
+    let points: Vec<(f64, f64)> = workloads
+        .iter()
+        .filter(|w| w.name == BRANCH_WITH_EIGENVALUES)
+        .map(|w| ((w.segments as f64).ln(), w.seconds.ln()))
+        .collect();
+    if points.len() < 2 {
+        return None;
+    }
+    let m = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / m, b + y / m));
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    Some(sxy / sxx)
 }
 
 /// Names of the workloads that compute the Figure 3 events from X to the fold.
@@ -519,6 +554,14 @@ pub fn print(r: &Report, out: &mut impl std::io::Write) -> std::io::Result<()> {
             w.accuracy.map_or("".into(), |a| format!("{a:.1e}"))
         )?;
     }
+    if let Some(x) = r.branch_exponent {
+        writeln!(
+            out,
+            "\nThe Figure 3 branch with eigenvalues: time grows as N^{x:.2} (least squares, N = {} … {}).",
+            BRANCH_SEGMENTS[0],
+            BRANCH_SEGMENTS[BRANCH_SEGMENTS.len() - 1]
+        )?;
+    }
     writeln!(
         out,
         "\nTime to the Figure 3 events (W2, X, W1, S, F1, from X to the fold) within a given error of the converged continuum values (the fastest workload above that reaches it):\n"
@@ -559,4 +602,34 @@ pub fn print(r: &Report, out: &mut impl std::io::Write) -> std::io::Result<()> {
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn workload(name: &str, segments: usize, seconds: f64) -> Workload {
+        Workload {
+            name: name.into(),
+            segments,
+            seconds,
+            newton_iterations: 0,
+            factorizations: 0,
+            peak_bytes: 0,
+            accuracy: None,
+        }
+    }
+
+    #[test]
+    fn the_branch_exponent_is_the_slope_of_log_time_on_log_n() {
+        // t = 3e-3 N^1.5 with a workload of another name beside it
+        let mut w: Vec<Workload> = BRANCH_SEGMENTS
+            .iter()
+            .map(|&n| workload(BRANCH_WITH_EIGENVALUES, n, 3e-3 * (n as f64).powf(1.5)))
+            .collect();
+        w.push(workload("figure_3_branch", 200, 100.0));
+        let x = branch_exponent(&w).unwrap();
+        assert!((x - 1.5).abs() < 1e-12, "{x}");
+        assert_eq!(branch_exponent(&w[..1]), None);
+    }
 }
