@@ -152,6 +152,19 @@ fn figure_3_events_at_n_200() {
         bp.detail.starts_with("negative eigenvalues 0 → 1"),
         "{bp:?}"
     );
+    // every bisected event says how closely: φ/2π within the locate
+    // tolerance's worth (1e-9 in arclength), a fold to second order
+    for e in events.iter().filter(|e| e.kind != EventKind::End) {
+        let within = e
+            .located_within
+            .unwrap_or_else(|| panic!("{e:?} has no bracket"));
+        assert!(
+            within < 1e-8,
+            "{} at {} within {within:.1e}",
+            e.kind,
+            e.phi_over_2pi
+        );
+    }
 }
 
 #[test]

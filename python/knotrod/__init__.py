@@ -390,7 +390,9 @@ class Event:
     ``"branch_point"``, ``"fold"``, ``"jump"``, ...), ``label`` as in the
     paper's figures (W1, W2, X, S, F1...), where (``phi_over_2pi``,
     ``z_star``, ``delta``), ``twist``, ``branch`` and ``detail``;
-    ``continuum`` when polished."""
+    ``continuum`` when polished; ``located_within``, the width of the
+    parameter interval (φ as φ/2π) a bisected event lies in (None for
+    events not bisected)."""
 
     kind: Union["EventKind", str]
     label: str
@@ -400,6 +402,7 @@ class Event:
     twist: float
     branch: int
     detail: str
+    located_within: Optional[float]
 
     def __init__(self, data: Dict[str, Any]) -> None:
         self._data = data
@@ -407,6 +410,8 @@ class Event:
             setattr(self, k, v)
         if "continuum" not in data:
             self.continuum = None
+        if "located_within" not in data:
+            self.located_within = None
         try:
             self.kind = EventKind(data.get("kind"))
         except ValueError:

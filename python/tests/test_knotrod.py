@@ -71,6 +71,8 @@ def test_figure_3_events(root):
     assert abs(x.phi_over_2pi - 0.96) < 0.01
     assert 0.745 < s.phi_over_2pi < w1.phi_over_2pi
     assert s.detail.startswith("negative eigenvalues 0 → 1")
+    # each bisected event says how closely it was located
+    assert all(e.located_within is not None and e.located_within < 1e-8 for e in (w1, w2, x, s))
     # columns: one array per scalar, as pandas.DataFrame takes them
     cols = b.columns()
     assert all(len(v) == len(b) for v in cols.values())

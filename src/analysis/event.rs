@@ -111,6 +111,12 @@ pub struct Event {
     /// when its polish was asked and failed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub not_polished: Option<PolishFailure>,
+    /// Width of the interval of the continuation's parameter (φ as φ/2π)
+    /// the discrete event was bisected to: it lies within it (wider than
+    /// the locate tolerance gives where the bisection stopped at a singular
+    /// point). None for events not bisected.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub located_within: Option<f64>,
 }
 
 /// Why an event was not polished on the continuum branch (typed, so a
@@ -227,6 +233,7 @@ impl Event {
             clamps: (!c.is_paper() || !c.scalars.is_unset()).then_some(*c),
             continuum: None,
             not_polished: None,
+            located_within: None,
         }
     }
 

@@ -97,6 +97,16 @@ pub enum ContinuationError {
     Newton(#[from] SolveError),
 }
 
+/// A located change along a branch: the first point past it, and the width
+/// of the parameter's interval it lies in.
+#[derive(Clone, Debug)]
+pub struct Bracketed {
+    /// The first point where the predicate fails.
+    pub point: Point,
+    /// |parameter there − parameter at the last point where it held|.
+    pub within: f64,
+}
+
 /// Traces branches of equilibria of one rod in one parameter.
 pub struct Tracer<'a> {
     /// Energy, factorisation workspace.
@@ -450,7 +460,21 @@ impl<'a> Tracer<'a> {
         sigma: f64,
         same: &mut dyn FnMut(&mut Self, &Point) -> bool,
     ) -> Result<Point, ContinuationError> {
+        self.locate_bracketed(from, sigma, same).map(|b| b.point)
+    }
+
+    /// [`Self::locate`], with the width of the parameter's interval the
+    /// change was bisected to: `locate_tolerance`'s worth, or wider where
+    /// the corrector failed near a singular point and the bisection stopped
+    /// there.
+    pub fn locate_bracketed(
+        &mut self,
+        from: &Point,
+        sigma: f64,
+        same: &mut dyn FnMut(&mut Self, &Point) -> bool,
+    ) -> Result<Bracketed, ContinuationError> {
         let (mut lo, mut hi) = (0.0, sigma);
+        let mut lo_value = self.parameter_of(&from.state);
         let mut last: Option<Point> = None;
         while (hi - lo).abs() > self.settings.locate_tolerance {
             let mid = 0.5 * (lo + hi);
@@ -466,15 +490,20 @@ impl<'a> Tracer<'a> {
             let Some((at, p)) = found else { break };
             if same(self, &p) {
                 lo = at;
+                lo_value = self.parameter_of(&p.state);
             } else {
                 hi = at;
                 last = Some(p);
             }
         }
-        match last {
-            Some(p) => Ok(p),
-            None => self.correct(from, hi, None),
-        }
+        let point = match last {
+            Some(p) => p,
+            None => self.correct(from, hi, None)?,
+        };
+        Ok(Bracketed {
+            within: (self.parameter_of(&point.state) - lo_value).abs(),
+            point,
+        })
     }
 
     /// Lowest eigenvalue and its eigenvector of the Hessian at a point.

@@ -8,7 +8,9 @@ use crate::analysis::equilibrium::{
 };
 use crate::analysis::event::{Event, EventKind};
 use crate::model::rod::{Parameter, RodState};
-use crate::solve::continuation::{ContinuationError, ContinuationSettings, Point, Tracer};
+use crate::solve::continuation::{
+    Bracketed, ContinuationError, ContinuationSettings, Point, Tracer,
+};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
 use crate::study::error::{Context, Result};
@@ -157,6 +159,14 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         self.located.push(p.state.clone());
     }
 
+    /// Record an event located by bisection, with its bracket.
+    fn record_located(&mut self, kind: EventKind, b: &Bracketed, branch: usize, detail: String) {
+        let mut e = event(kind, &b.point, branch, detail);
+        e.located_within = Some(b.within);
+        self.events.push(e);
+        self.located.push(b.point.state.clone());
+    }
+
     fn in_range(&self, p: &Point) -> bool {
         let v = self.tracer.parameter_of(&p.state);
         v >= self.options.range[0] && v <= self.options.range[1]
@@ -277,7 +287,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
     /// The parameter turns back: a fold, or a symmetric branch point.
     fn locate_fold(&mut self, a: &Point, b: &Point, ds: f64, branch: usize) -> Result<()> {
         let s = a.tangent_p.signum();
-        let p = self
+        let located = self
             .locate(a, ds, &mut |_, p| p.tangent_p.signum() == s)
             .context("locating a fold")?;
         let detail = format!(
@@ -291,9 +301,9 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             // φ, Tw, walls): a symmetric branch point, not a fold
             let detail =
                 format!("{detail}; through a symmetric branch point onto the mirror branch");
-            self.record(EventKind::BranchPoint, &p, branch, detail);
+            self.record_located(EventKind::BranchPoint, &located, branch, detail);
         } else {
-            self.record(EventKind::Fold, &p, branch, detail);
+            self.record_located(EventKind::Fold, &located, branch, detail);
         }
         Ok(())
     }
@@ -309,20 +319,20 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         fold: bool,
     ) -> Result<()> {
         let na = a.negative_count;
-        let p = self
+        let located = self
             .locate(a, ds, &mut |_, p| p.negative_count == na)
             .context("locating a change of stability")?;
         let detail = format!("negative eigenvalues {} → {}", na, b.negative_count);
-        self.record(EventKind::Stability, &p, branch, detail.clone());
+        self.record_located(EventKind::Stability, &located, branch, detail.clone());
         if !fold {
-            let (lambda, null) = self.tracer.lowest_mode(&p)?;
-            self.record(
+            let (lambda, null) = self.tracer.lowest_mode(&located.point)?;
+            self.record_located(
                 EventKind::BranchPoint,
-                &p,
+                &located,
                 branch,
                 format!("{detail}; eigenvalue there {lambda:.2e}"),
             );
-            self.branch_points.push((p, null, branch));
+            self.branch_points.push((located.point, null, branch));
         }
         Ok(())
     }
@@ -331,7 +341,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
     fn locate_wall(&mut self, a: &Point, wa: &TestValues, ds: f64, branch: usize) -> Result<()> {
         let inside = wa.wall > 0.0;
         let width = self.options.measure.strip_width;
-        let p = self
+        let located = self
             .locate(a, ds, &mut |_, p| {
                 (walls(&p.state, width).clearance > 0.0) == inside
             })
@@ -341,7 +351,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         } else {
             "enters the walls"
         };
-        self.record(EventKind::Wall, &p, branch, detail.into());
+        self.record_located(EventKind::Wall, &located, branch, detail.into());
         Ok(())
     }
 
@@ -357,7 +367,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
     ) -> Result<()> {
         let measure = self.options.measure.clone();
         let (ka, la) = (wa.knot.clone(), wa.link);
-        let p = self
+        let located = self
             .locate(a, ds, &mut |_, p| {
                 let (knot, link) = knot_of(&p.state, &measure, &wa.at);
                 knot == ka && (link - la).abs() < 1.0
@@ -370,9 +380,9 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             wa.link,
             wb.link
         );
-        self.record(EventKind::Crossing, &p, branch, detail.clone());
+        self.record_located(EventKind::Crossing, &located, branch, detail.clone());
         if wa.knot != wb.knot {
-            self.record(EventKind::KnotChange, &p, branch, detail);
+            self.record_located(EventKind::KnotChange, &located, branch, detail);
         }
         Ok(())
     }
@@ -389,7 +399,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
     ) -> Result<()> {
         let measure = self.options.measure.clone();
         let touching = wa.touching;
-        let p = self
+        let located = self
             .locate(a, ds, &mut |_, p| {
                 let d = self_approach(&p.state, &measure).map_or(f64::INFINITY, |a| a.distance);
                 ribbon_touches(d, &measure) == touching
@@ -400,7 +410,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         } else {
             "the ribbon touches itself"
         };
-        self.record(EventKind::Crossing, &p, branch, detail.into());
+        self.record_located(EventKind::Crossing, &located, branch, detail.into());
         Ok(())
     }
 
@@ -409,7 +419,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         from: &Point,
         sigma: f64,
         same: &mut dyn FnMut(&mut Tracer<'a>, &Point) -> bool,
-    ) -> Result<Point, ContinuationError> {
-        self.tracer.locate(from, sigma, same)
+    ) -> Result<Bracketed, ContinuationError> {
+        self.tracer.locate_bracketed(from, sigma, same)
     }
 }
