@@ -242,19 +242,20 @@ impl<'a> ContinuumBranch<'a> {
                 }
             }
             // the step halved while the residual does not fall (a failed
-            // integration counts as not falling)
+            // integration counts as not falling); the trial points need only
+            // the residual, a fraction of the Jacobian's integration
             let mut t = 1.0;
             let mut next = None;
             for _ in 0..10 {
-                if let Ok((rn, jn)) = self.linearise(&(z + t * step))
+                if let Ok(rn) = self.residual_at(&(z + t * step))
                     && rn.norm() < residual
                 {
-                    next = Some((rn, jn));
+                    next = Some(rn);
                     break;
                 }
                 t *= 0.5;
             }
-            let Some((rn, jn)) = next else {
+            let Some(rn) = next else {
                 // at the integrator's noise the residual no longer falls (near
                 // a branch point, whose null direction amplifies the noise,
                 // that floor lies well above the tolerance)
@@ -268,11 +269,12 @@ impl<'a> ContinuumBranch<'a> {
                 });
             };
             z += t * step;
-            (r, jac) = (rn, jn);
             let scale = 1.0 + z.fixed_rows::<6>(0).norm();
-            if t == 1.0 && dx.norm() < 1e-11 * scale {
+            // converged: the Jacobian there is not needed
+            if rn.norm() < tol || (t == 1.0 && dx.norm() < 1e-11 * scale) {
                 return Ok(z);
             }
+            (r, jac) = self.linearise(&z)?;
         }
         if r.norm() < NOISE_FLOOR * self.tolerance {
             return Ok(z);
@@ -281,6 +283,12 @@ impl<'a> ContinuumBranch<'a> {
             iterations: CORRECTOR_ITERATIONS,
             residual: r.norm(),
         })
+    }
+
+    /// The s = 1 residual at z.
+    fn residual_at(&self, z: &BranchPoint) -> Result<Vector6<f64>, BranchError> {
+        let p: Unknowns = z.fixed_rows::<6>(0).into();
+        Ok(self.problem(z[PARAMETER])?.residual(&p)?)
     }
 
     /// Frames at the increasing arclengths `stops`, on the solution at z.
