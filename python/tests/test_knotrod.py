@@ -209,7 +209,10 @@ def test_a_progress_callback_that_raises_stops_the_run(root):
 
 
 CHILD = r"""
-import sys, knotrod
+import signal, sys, knotrod
+# a child started from a non-interactive shell's background job inherits
+# SIGINT ignored, and Python then installs no KeyboardInterrupt handler
+signal.signal(signal.SIGINT, signal.default_int_handler)
 scene = knotrod.Scene.from_toml(sys.argv[1]).with_(continuation={"step": 0.0005, "max_step": 0.001})
 def progress(point):
     print("point", point["index"], flush=True)
