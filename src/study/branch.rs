@@ -161,10 +161,10 @@ impl<'a, 'r> BranchRun<'a, 'r> {
 
     /// Record an event located by bisection, with its bracket.
     fn record_located(&mut self, kind: EventKind, b: &Bracketed, branch: usize, detail: String) {
-        let mut e = event(kind, &b.point, branch, detail);
-        e.located_within = Some(b.within);
-        self.events.push(e);
-        self.located.push(b.point.state.clone());
+        self.record(kind, &b.point, branch, detail);
+        if let Some(e) = self.events.last_mut() {
+            e.located_within = Some(b.within);
+        }
     }
 
     fn in_range(&self, p: &Point) -> bool {

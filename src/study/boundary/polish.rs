@@ -766,7 +766,7 @@ impl Plane<'_> {
             .into_iter()
             .map(|(condition, at, e)| DroppedPoint {
                 condition,
-                at,
+                at: Some(at),
                 why: e.failure(),
             })
             .collect();

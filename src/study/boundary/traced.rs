@@ -87,24 +87,29 @@ pub struct PolishedBoundary {
 pub struct DroppedPoint {
     /// The condition of its piece, as the pieces name it.
     pub condition: String,
-    /// The discrete point (swept parameter, value along).
-    pub at: [f64; 2],
+    /// The discrete point (swept parameter, value along); None in maps
+    /// written before the points were kept as data.
+    #[serde(default)]
+    pub at: Option<[f64; 2]>,
     /// Why it could not be polished.
     pub why: PolishFailure,
 }
 
 impl std::fmt::Display for DroppedPoint {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{} at ({:.5}, {:.5}): {}",
-            self.condition, self.at[0], self.at[1], self.why
-        )
+        match self.at {
+            Some(at) => write!(
+                f,
+                "{} at ({:.5}, {:.5}): {}",
+                self.condition, at[0], at[1], self.why
+            ),
+            None => write!(f, "{}", self.why),
+        }
     }
 }
 
 /// Dropped points written as data, or as the lines of text earlier versions
-/// wrote (kept whole as the reason, at an unknown point).
+/// wrote (kept whole as the reason, the point not known apart from it).
 fn dropped_data_or_text<'de, D>(d: D) -> Result<Vec<DroppedPoint>, D::Error>
 where
     D: serde::Deserializer<'de>,
@@ -121,7 +126,7 @@ where
             Written::Data(p) => p,
             Written::Text(message) => DroppedPoint {
                 condition: String::new(),
-                at: [f64::NAN; 2],
+                at: None,
                 why: PolishFailure::Continuum { message },
             },
         })
@@ -405,7 +410,7 @@ mod tests {
     fn a_dropped_point_keeps_its_condition_place_and_reason() {
         let d = DroppedPoint {
             condition: "wall".into(),
-            at: [0.17, 0.8],
+            at: Some([0.17, 0.8]),
             why: PolishFailure::NoSelfApproach,
         };
         let json = serde_json::to_value(vec![d.clone()]).unwrap();
@@ -421,5 +426,10 @@ mod tests {
         assert!(
             matches!(&back[0].why, PolishFailure::Continuum { message } if message.contains("wall at"))
         );
+        // read from old text, written and read again unchanged (no NaN
+        // placeholder, which JSON writes as null)
+        let again = dropped_data_or_text(serde_json::to_value(&back).unwrap()).unwrap();
+        assert_eq!(again, back);
+        assert_eq!(back[0].to_string(), "wall at (0.1, 0.8): no self-approach");
     }
 }
