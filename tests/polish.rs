@@ -147,3 +147,49 @@ fn the_polish_is_reported_in_the_summary_json() {
     let folds = events.iter().filter(|e| e.kind == EventKind::Fold).count();
     assert_eq!(folds, 1, "{events:#?}");
 }
+
+#[test]
+fn the_corrector_refuses_a_point_held_just_past_a_fold_where_no_solution_exists() {
+    // honest convergence: past the fold F1 there is no equilibrium at that
+    // parameter, and Newton's method stalls at a small residual there; it
+    // must be refused, while the branch on the near side converges
+    let (scene, events) = polished_events(60);
+    let f = find(&events, "F1", EventKind::Fold)
+        .continuum
+        .clone()
+        .unwrap();
+    let model = scene.rod_model(Some(60));
+    let clamps = knotrod::model::rod::Clamps::new(0.115, 0.05, f.value);
+    let tolerance = 1e-10;
+    let branch = ContinuumBranch::new(
+        &model,
+        clamps,
+        knotrod::model::rod::Parameter::Phi,
+        tolerance,
+    )
+    .unwrap();
+    let mut fold = BranchPoint::zeros();
+    fold.fixed_rows_mut::<6>(0)
+        .copy_from(&Unknowns::from(f.unknowns));
+    fold[PARAMETER] = f.value;
+    // the side of the fold the branch lies on: step along its tangent
+    // holding the unknown it moves along fastest (the fold is flat: the
+    // parameter moves by about 4e-5 σ² at a distance σ)
+    let t = branch.tangent(&fold).unwrap();
+    let held = (0..6)
+        .max_by(|&a, &b| t[a].abs().total_cmp(&t[b].abs()))
+        .unwrap();
+    let near = branch.correct(fold + 1e-2 * t, held).unwrap();
+    let side = (near[PARAMETER] - f.value).signum();
+    assert!((near[PARAMETER] - f.value).abs() > 1e-9);
+    let mut past = fold;
+    past[PARAMETER] = f.value - side * 1e-7;
+    match branch.correct(past, PARAMETER) {
+        Err(knotrod::solve::continuum::branch::BranchError::Corrector { residual, .. }) => {
+            // small enough that a floor of 1e5 tolerances took it for a solution
+            assert!(residual < 1e5 * tolerance, "residual {residual:.3e}");
+            assert!(residual > 1e3 * tolerance, "residual {residual:.3e}");
+        }
+        other => panic!("past the fold: {other:?}"),
+    }
+}

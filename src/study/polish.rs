@@ -296,13 +296,7 @@ fn polish_one(
     // hold the parameter, except at a fold: there the unknown the branch
     // moves along fastest (relative to its size)
     let held = if fold {
-        let t = branch.tangent(&z)?;
-        (0..6)
-            .max_by(|&a, &b| {
-                let w = |k: usize| t[k].abs() / (1.0 + z[k].abs());
-                w(a).total_cmp(&w(b))
-            })
-            .unwrap_or(0)
+        fold_held(&branch, &z)?
     } else {
         PARAMETER
     };
@@ -332,6 +326,19 @@ fn polish_one(
         arclengths,
         steps: root.steps,
     })
+}
+
+/// The coordinate to hold while locating a fold: the unknown the branch
+/// moves along fastest at z (relative to its size). Holding the parameter
+/// there would ask for a solution past the fold, where there is none.
+pub(crate) fn fold_held(branch: &ContinuumBranch, z: &BranchPoint) -> Result<usize, PolishError> {
+    let t = branch.tangent(z)?;
+    Ok((0..6)
+        .max_by(|&a, &b| {
+            let w = |k: usize| t[k].abs() / (1.0 + z[k].abs());
+            w(a).total_cmp(&w(b))
+        })
+        .unwrap_or(0))
 }
 
 /// A test function's root on a continuum branch, located at

@@ -25,9 +25,9 @@ pub const PARAMETER: usize = 6;
 
 /// Corrector iterations before giving up.
 const CORRECTOR_ITERATIONS: usize = 30;
-/// A residual this many tolerances small that Newton cannot reduce is at
-/// the integrator's noise.
-const NOISE_FLOOR: f64 = 1e5;
+/// The factor by which the integrator's tolerance is tightened to measure
+/// its noise in the residual.
+const NOISE_PROBE: f64 = 1e-2;
 /// Secant steps before giving up.
 const SECANT_ITERATIONS: usize = 40;
 
@@ -206,7 +206,7 @@ impl<'a> ContinuumBranch<'a> {
     pub fn correct(&self, mut z: BranchPoint, held: usize) -> Result<BranchPoint, BranchError> {
         let tol = (10.0 * self.tolerance).max(1e-14);
         let (mut r, mut jac) = self.linearise(&z)?;
-        for _ in 0..CORRECTOR_ITERATIONS {
+        for iteration in 0..CORRECTOR_ITERATIONS {
             let residual = r.norm();
             if residual < tol {
                 return Ok(z);
@@ -221,68 +221,120 @@ impl<'a> ContinuumBranch<'a> {
             }
             // a truncated SVD solve: a direction whose singular value is below
             // 1e-7 of the largest is a branch point's null direction, in
-            // which the residual is the integrator's noise (on a symmetric
-            // branch through a pitchfork); stepping along it would amplify
-            // that noise
+            // which the residual is often the integrator's noise (on a
+            // symmetric branch through a pitchfork), and stepping along it
+            // would amplify that noise. But a start off the symmetric branch
+            // leaves a true residual there that only the full solve removes:
+            // where directions were dropped, both steps are tried and the one
+            // reaching the smaller residual taken
             let svd = a.svd(true, true);
-            let cutoff = 1e-7 * svd.singular_values.max();
-            let Some(dx) = svd
-                .solve(&(-r), cutoff)
-                .ok()
-                .filter(|d| d.iter().all(|v| v.is_finite()))
-            else {
-                return Err(ContinuumError::Singular.into());
-            };
-            let mut step = BranchPoint::zeros();
-            let mut k = 0;
-            for c in 0..7 {
-                if c != held {
-                    step[c] = dx[k];
-                    k += 1;
-                }
-            }
-            // the step halved while the residual does not fall (a failed
-            // integration counts as not falling); the trial points need only
-            // the residual, a fraction of the Jacobian's integration
-            let mut t = 1.0;
-            let mut next = None;
-            for _ in 0..10 {
-                if let Ok(rn) = self.residual_at(&(z + t * step))
-                    && rn.norm() < residual
-                {
-                    next = Some(rn);
+            let largest = svd.singular_values.max();
+            let cutoff = 1e-7 * largest;
+            let truncated = svd.singular_values.iter().any(|&v| v < cutoff);
+            let mut next: Option<(Vector6<f64>, BranchPoint)> = None;
+            let mut solved = false;
+            for eps in [cutoff, f64::EPSILON * largest] {
+                if eps < cutoff && !truncated {
                     break;
                 }
-                t *= 0.5;
-            }
-            let Some(rn) = next else {
-                // at the integrator's noise the residual no longer falls (near
-                // a branch point, whose null direction amplifies the noise,
-                // that floor lies well above the tolerance)
-                let scale = 1.0 + z.fixed_rows::<6>(0).norm();
-                if dx.norm() < 1e-9 * scale || residual < NOISE_FLOOR * self.tolerance {
-                    return Ok(z);
+                let Some(dx) = svd
+                    .solve(&(-r), eps)
+                    .ok()
+                    .filter(|d| d.iter().all(|v| v.is_finite()))
+                else {
+                    continue;
+                };
+                solved = true;
+                let mut step = BranchPoint::zeros();
+                let mut k = 0;
+                for c in 0..7 {
+                    if c != held {
+                        step[c] = dx[k];
+                        k += 1;
+                    }
                 }
-                return Err(BranchError::Corrector {
-                    iterations: CORRECTOR_ITERATIONS,
-                    residual,
-                });
+                if let Some((rn, s)) = self.line_search(&z, &step, residual)
+                    && next
+                        .as_ref()
+                        .is_none_or(|(best, _)| rn.norm() < best.norm())
+                {
+                    next = Some((rn, s));
+                }
+            }
+            if !solved {
+                return Err(ContinuumError::Singular.into());
+            }
+            let Some((rn, step)) = next else {
+                // the residual no longer falls: converged if what remains is
+                // the integrator's noise (near a branch point, whose null
+                // direction amplifies it, that lies well above the tolerance)
+                return self.at_noise(z, &r, iteration);
             };
-            z += t * step;
+            z += step;
             let scale = 1.0 + z.fixed_rows::<6>(0).norm();
             // converged: the Jacobian there is not needed
-            if rn.norm() < tol || (t == 1.0 && dx.norm() < 1e-11 * scale) {
+            if rn.norm() < tol {
                 return Ok(z);
+            }
+            // a full step too small to move z: Newton is done, and z a
+            // solution only if the residual left is noise (the truncated
+            // solve cannot reduce a residual along a dropped null direction,
+            // as just past a fold)
+            if step.norm() < 1e-11 * scale {
+                return self.at_noise(z, &rn, iteration + 1);
             }
             (r, jac) = self.linearise(&z)?;
         }
-        if r.norm() < NOISE_FLOOR * self.tolerance {
-            return Ok(z);
+        self.at_noise(z, &r, CORRECTOR_ITERATIONS)
+    }
+
+    /// The Newton step from z halved while the residual does not fall below
+    /// `residual` (a failed integration counts as not falling): the residual
+    /// reached and the step taken. The trial points need only the residual,
+    /// a fraction of the Jacobian's integration.
+    fn line_search(
+        &self,
+        z: &BranchPoint,
+        step: &BranchPoint,
+        residual: f64,
+    ) -> Option<(Vector6<f64>, BranchPoint)> {
+        let mut t = 1.0;
+        for _ in 0..10 {
+            if let Ok(rn) = self.residual_at(&(z + t * step))
+                && rn.norm() < residual
+            {
+                return Some((rn, t * step));
+            }
+            t *= 0.5;
         }
-        Err(BranchError::Corrector {
-            iterations: CORRECTOR_ITERATIONS,
+        None
+    }
+
+    /// z, where Newton's method made no more progress with residual `r`, if
+    /// that residual is the integrator's noise: measured again at a hundredth
+    /// of the tolerance, the residual left must be no larger than its change
+    /// (the noise of the working tolerance). Otherwise z is not a solution.
+    fn at_noise(
+        &self,
+        z: BranchPoint,
+        r: &Vector6<f64>,
+        iterations: usize,
+    ) -> Result<BranchPoint, BranchError> {
+        let refused = BranchError::Corrector {
+            iterations,
             residual: r.norm(),
-        })
+        };
+        let Ok(fine) = self
+            .with_tolerance(self.tolerance * NOISE_PROBE)
+            .residual_at(&z)
+        else {
+            return Err(refused);
+        };
+        if fine.norm() <= (fine - r).norm() {
+            Ok(z)
+        } else {
+            Err(refused)
+        }
     }
 
     /// The s = 1 residual at z.
@@ -497,7 +549,15 @@ impl<'a> ContinuumBranch<'a> {
             ga = gb;
             zb = zc;
             gb = gc;
-            if dc.abs() < resolution {
+            // held at a fold, an unknown is only the path: the located
+            // quantity is the parameter, stationary there, and converged once
+            // it no longer moves at the integrator's tolerance (the test's
+            // noise may keep the unknown from reaching `resolution`)
+            let settled = held != PARAMETER
+                && (zb[PARAMETER] - za[PARAMETER]).abs()
+                    < self.tolerance * (1.0 + zb[PARAMETER].abs())
+                && ga.signum() != gb.signum();
+            if dc.abs() < resolution || settled {
                 return Ok(Located {
                     point: zb,
                     test,

@@ -15,7 +15,8 @@ use crate::study::boundary::traced::{
     DroppedPoint, Piece, PolishedBoundary, PolishedCorner, Trail, TrailPoint, name_pieces,
 };
 use crate::study::polish::{
-    CornerFailure, PolishError, discrete_unknowns, locate_root, singular_at,
+    CornerFailure, FOLD_RESOLUTION, PolishError, discrete_unknowns, fold_held, locate_root,
+    singular_at,
 };
 use rayon::prelude::*;
 
@@ -193,7 +194,17 @@ impl Plane<'_> {
         test: TestFunction,
         normal: [f64; 2],
     ) -> Result<Polished, PolishError> {
-        let root = locate_root(branch, z, PARAMETER, test)?;
+        let root = match locate_root(branch, z, PARAMETER, test.clone()) {
+            Ok(root) => root,
+            // a change of stability is a branch point of the symmetric family
+            // (the parameter held crosses it) or a fold of the line (no
+            // solution past it at that parameter): there an unknown is held
+            Err(e) if matches!(test, TestFunction::Singular { .. }) => {
+                let held = fold_held(branch, &z).map_err(|_| e)?;
+                locate_root(branch, z, held, test)?
+            }
+            Err(e) => return Err(e),
+        };
         at[free] = root.fine.point[PARAMETER];
         Ok(Polished {
             at,
@@ -243,7 +254,18 @@ impl Plane<'_> {
         let free = usize::from((b.at[0] - a.at[0]).abs() >= (b.at[1] - a.at[1]).abs());
         // a root may lie as far from the chord as the chord is long
         let chord = (b.at[0] - a.at[0]).hypot(b.at[1] - a.at[1]);
-        self.near_neighbours(at, free, &near, self.spacing.max(chord))
+        let reach = self.spacing.max(chord);
+        // else the other line through that point (as for a walk point): a
+        // line meeting the curve where it is a fold of that line may hold
+        // no solution near the root
+        self.near_neighbours(at, free, &near, reach)
+            .or_else(|first| {
+                self.near_neighbours(at, 1 - free, &near, reach)
+                    .map_err(|second| PolishError::BothWays {
+                        first: Box::new(first),
+                        second: Box::new(second),
+                    })
+            })
     }
 
     /// Each gap of the pieces split into `parts(a, b)` equal parts, the
@@ -395,14 +417,23 @@ impl Plane<'_> {
             let mut q = at;
             q[held] = v;
             let branch = self.line(q, free, tolerance)?;
-            let scale = 1.0 + z[PARAMETER].abs();
-            let located = branch.locate(
-                z,
-                PARAMETER,
-                1e-4 * scale,
-                0.1 * tolerance * scale,
-                ta.clone(),
-            )?;
+            let along = |held: usize| {
+                let scale = 1.0 + z[held].abs();
+                let resolution = if held == PARAMETER {
+                    0.1 * tolerance
+                } else {
+                    FOLD_RESOLUTION
+                };
+                branch.locate(z, held, 1e-4 * scale, resolution * scale, ta.clone())
+            };
+            // as in root_on: at a fold of the line an unknown is held
+            let located = match along(PARAMETER) {
+                Ok(located) => located,
+                Err(e) if matches!(ta, TestFunction::Singular { .. }) => {
+                    along(fold_held(&branch, &z).map_err(|_| e)?)?
+                }
+                Err(e) => return Err(e.into()),
+            };
             let (tb, gb) = branch.evaluate(&located.point, tb)?;
             q[free] = located.point[PARAMETER];
             let error = (located.point[PARAMETER] - located.previous[PARAMETER]).abs();
