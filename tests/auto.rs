@@ -15,7 +15,7 @@ use knotrod::study::verify::{Verdict, VerifyOptions, verify_all};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-mod common;
+use crate::common;
 
 const S_SMALL: &str = "tests/fixtures/auto/s.small";
 const B_SMALL: &str = "tests/fixtures/auto/b.small";

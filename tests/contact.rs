@@ -6,7 +6,7 @@ use knotrod::analysis::event::{Event, EventKind};
 use knotrod::scene::Scene;
 use knotrod::study::start::solve_scene;
 
-mod common;
+use crate::common;
 use common::run;
 
 /// A straight clamped-clamped rod (z* = 1) whose midpoint is pushed sideways

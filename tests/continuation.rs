@@ -5,7 +5,7 @@ use knotrod::analysis::equilibrium::Equilibrium;
 use knotrod::analysis::event::{Event, EventKind};
 use knotrod::scene::Scene;
 
-mod common;
+use crate::common;
 use common::run;
 
 /// Every state of a loading path a converged minimum; its jumps.

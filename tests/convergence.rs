@@ -12,7 +12,7 @@ use knotrod::study::start::starting_equilibrium;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use std::cell::Cell;
 
-mod common;
+use crate::common;
 
 /// ‖∇E‖, its relative value, the measured floor and its bound at `state`.
 fn gradient_at(newton: &Minimizer, state: &RodState) -> (f64, f64, f64, f64) {

@@ -69,7 +69,7 @@ fn writhe_of_the_ray_closure_converges_as_one_over_ray_length() {
     }
 }
 
-mod common;
+use crate::common;
 use common::Lcg;
 
 #[test]

@@ -6,7 +6,7 @@ use knotrod::model::natural::NaturalStrains;
 use knotrod::model::rod::{Clamps, EndKind, Ends, Law, Parameter, RodModel, RodState};
 use nalgebra::Vector3;
 
-mod common;
+use crate::common;
 use common::Lcg;
 
 fn random_state(n: usize, seed: u64) -> (RodModel, RodState) {

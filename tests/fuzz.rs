@@ -3,7 +3,7 @@
 //! recordings must give an answer or an error, never a panic. The seed is
 //! fixed so that a failure reproduces; the long runs are cargo fuzz's.
 
-mod common;
+use crate::common;
 
 use common::{knotrod, temp_dir};
 use knotrod::io::fuzz;

@@ -6,7 +6,7 @@ use knotrod::geometry::writhe::{segment_pair_writhe, try_writhe_closed, writhe_c
 use nalgebra::{Rotation3, Vector3};
 use std::f64::consts::PI;
 
-mod common;
+use crate::common;
 use common::Lcg;
 
 fn direction(rng: &mut Lcg) -> Vector3<f64> {

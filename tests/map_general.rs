@@ -9,7 +9,7 @@ use knotrod::scene::Scene;
 use knotrod::study::map::{Map, branch_intervals_in};
 use serde_json::Value;
 
-mod common;
+use crate::common;
 use common::{map_json, run, temp_dir};
 
 /// A scene file's text with some settings replaced (each must be there).

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{knotrod, knotrod_ok, map_json, temp_dir};
 
 /// The Figure 7-left scene with some settings replaced, written into `dir`.

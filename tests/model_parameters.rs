@@ -9,7 +9,7 @@ use knotrod::report::analytic::greenhill_constant;
 use knotrod::scene::Scene;
 use nalgebra::Vector3;
 
-mod common;
+use crate::common;
 use common::run;
 
 #[test]

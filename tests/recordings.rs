@@ -9,7 +9,7 @@ use knotrod::io::recording::{
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-mod common;
+use crate::common;
 use common::{knotrod, temp_dir};
 
 /// Run a scene recording to `rec`; the recording's bytes.

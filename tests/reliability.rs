@@ -3,7 +3,7 @@
 //! show progress, non-finite starts name their input, files are read only
 //! up to a limit.
 
-mod common;
+use crate::common;
 
 use common::{knotrod, temp_dir};
 use knotrod::scene::{Job, Scene, SceneError};

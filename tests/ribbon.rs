@@ -2,7 +2,7 @@
 //! values, its convergence to the centreline's as the width goes to zero, the
 //! width 0 path unchanged, and the scene field validated.
 
-mod common;
+use crate::common;
 
 use knotrod::analysis::equilibrium::{Conformation, Measure, self_approach, walls};
 use knotrod::analysis::event::{Event, EventKind};

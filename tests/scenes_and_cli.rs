@@ -2,7 +2,7 @@
 
 use knotrod::scene::{Scene, SceneError};
 
-mod common;
+use crate::common;
 use common::{knotrod, temp_dir};
 
 const GOOD: &str = r#"

@@ -14,7 +14,7 @@ use knotrod::solve::outcome::SolverSettings;
 use knotrod::study::start::starting_equilibrium;
 use nalgebra::DMatrix;
 
-mod common;
+use crate::common;
 use common::{run, scene_at};
 
 /// The double ring (z* = δ = 0, φ = 2π) of `kind` at N segments, relaxed.

@@ -11,7 +11,7 @@ use knotrod::study::verify::{
 };
 use std::path::Path;
 
-mod common;
+use crate::common;
 
 fn verify(file: &str, fit: Option<Parameter>) -> Vec<SolutionCheck> {
     let (scene, solutions) = read_solutions(Path::new(file), None).unwrap();

@@ -3,7 +3,7 @@
 //! disk (a small tmpfs, when this machine lets the test mount one) and the
 //! files of a run left whole.
 
-mod common;
+use crate::common;
 
 use common::temp_dir;
 use knotrod::io::recording::read_recording;

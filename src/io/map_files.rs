@@ -73,9 +73,9 @@ struct KeptLine {
     line: Line,
 }
 
-/// The version of the sources that compute a line: a hash of their contents
-/// made by build.rs (not the package version, which a rebuild keeps).
-pub const SOURCE_VERSION: &str = env!("KNOTROD_SOURCE_HASH");
+/// The version of the sources that compute a line (see
+/// [`crate::io::build_info::SOURCE_HASH`]).
+pub const SOURCE_VERSION: &str = crate::io::build_info::SOURCE_HASH;
 
 /// What determines a map's lines and walk: the whole scene after defaults
 /// (model, start, solver, continuation, map), the map settings, N and the

@@ -3,6 +3,7 @@
 //! AUTO-07p's output for verify.
 
 pub mod auto;
+pub mod build_info;
 pub mod convergence_plot;
 pub mod curve_file;
 pub mod error;
@@ -14,6 +15,7 @@ pub mod output;
 pub mod plot;
 pub mod recording;
 pub mod scene_file;
+pub mod source_hash;
 pub mod summary;
 pub mod verify_file;
 

@@ -1,7 +1,7 @@
 //! Shared test helpers: the built binary, temporary directories, scenes at
 //! another N, runs collected, and a deterministic random sequence.
 //!
-//! Each test file compiles its own copy and uses only some of these.
+//! One module of the test binary (tests/suite.rs); each area uses some of these.
 #![allow(dead_code)]
 
 use knotrod::analysis::equilibrium::Equilibrium;

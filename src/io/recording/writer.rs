@@ -104,7 +104,7 @@ fn write_metadata(
     );
     meta.insert(
         "git_revision".to_string(),
-        env!("KNOTROD_GIT_REVISION").to_string(),
+        crate::io::build_info::git_revision().to_string(),
     );
     let model_json =
         serde_json::to_string(model).map_err(IoError::json("encoding the model", path))?;
