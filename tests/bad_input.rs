@@ -323,3 +323,22 @@ fn numbers_in_errors_are_short() {
     let e = error_of(&format!("{GOOD}[diagnostics]\nray_length = 1e308\n"));
     assert!(e.contains("1e308"), "{e}");
 }
+
+#[test]
+fn a_contact_margin_past_a_quarter_of_the_rod_is_refused_by_name() {
+    // before: every pair a constraint, minutes of progress
+    let e = error_of(&format!("{GOOD}[contact]\nmargin = 10\n"));
+    assert!(e.contains("contact.margin") && e.contains("0.25"), "{e}");
+    Scene::parse(&format!("{GOOD}[contact]\nmargin = 0.25\n")).unwrap();
+}
+
+#[test]
+fn a_double_ring_that_does_not_relax_names_the_clamps_angle() {
+    // the ring traced with φ/2π = 3 of twist in it (before: "the double
+    // ring: Newton did not converge in 1000 iterations")
+    let text = "[model]\nsegments = 20\n[clamps]\nz_star = 0.0\ndelta = 0.0\nphi_over_2pi = 3.0\n\
+                [initial]\nshape = \"double_ring\"\n";
+    let scene = Scene::parse(text).unwrap();
+    let e = describe(&solve_scene(&scene, None).unwrap_err());
+    assert!(e.contains("clamps.phi_over_2pi = 3"), "{e}");
+}

@@ -22,6 +22,7 @@ mod knots;
 mod map_general;
 mod maps;
 mod model_parameters;
+mod output_paths;
 mod paper_equilibria;
 mod polish;
 mod profile;

@@ -119,7 +119,7 @@ fn a_full_disk_says_so_naming_the_file_and_leaves_the_previous_one() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{err}");
     assert!(
-        err.contains("no space left on device") && err.contains(&*rec.to_string_lossy()),
+        err.contains("No space left on device") && err.contains(&*rec.to_string_lossy()),
         "{err}"
     );
     assert!(!err.contains("attempted another write"), "{err}");
@@ -138,6 +138,6 @@ fn a_full_disk_says_so_naming_the_file_and_leaves_the_previous_one() {
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{err}");
-    assert!(err.contains("no space left on device"), "{err}");
+    assert!(err.contains("No space left on device"), "{err}");
     assert_eq!(std::fs::read_to_string(&json).unwrap(), "{}");
 }

@@ -32,6 +32,15 @@ pub fn map(
         .clone()
         .context("the scene has no [map] section")?;
     let name = scene.file_stem("map");
+    // a map keeps its lines, slices and plots beside its file
+    if let Some(p) = &json {
+        anyhow::ensure!(
+            crate::io::output::output_kind(p) == crate::io::output::OutputKind::File,
+            "--json {}: a map keeps its computed lines, slices and plots beside its \
+             file; name a file (not standard output, a FIFO or a device)",
+            p.display()
+        );
+    }
     let json = json.unwrap_or_else(|| PathBuf::from("recordings").join(format!("{name}.map.json")));
     let shard = match shard {
         Some(s) => Some(parse_shard(s)?),

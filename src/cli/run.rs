@@ -5,7 +5,7 @@
 use super::progress::Progress;
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
-use crate::io::output::Output;
+use crate::io::output::{Output, OutputKind, output_kind};
 use crate::io::plot::{PlotPoint, bifurcation_diagram};
 use crate::io::recording::Recorder;
 use crate::io::summary::{Summary, print_equilibrium, print_events};
@@ -43,6 +43,11 @@ pub fn run(
     let model = scene.rod_model(segments);
     let start = std::time::Instant::now();
     let json = json.or(scene.output.json.clone());
+    // a summary or recording on standard output (`-`) keeps it for itself:
+    // what is printed for people goes to standard error instead
+    let dash = |p: &Path| p.as_os_str() == "-";
+    let on_stdout =
+        json.as_deref().is_some_and(dash) || matches!(&record, Some(Some(p)) if dash(p));
     let mut summary = Summary::new(&scene, &model);
     let mut outputs = Outputs::open(path, &scene, &model, json.as_deref(), record)?;
     let progress = Progress::spinner("equilibria");
@@ -60,7 +65,11 @@ pub fn run(
         Ok(())
     });
     progress.finish();
-    let mut out = std::io::stdout().lock();
+    let mut out: Box<dyn Write> = if on_stdout {
+        Box::new(std::io::stderr().lock())
+    } else {
+        Box::new(std::io::stdout().lock())
+    };
     writeln!(
         out,
         "scene {} — {}, N = {} ({:.2} s, {} equilibria)",
@@ -84,7 +93,9 @@ pub fn run(
     if let Some(file) = summary_out {
         let path = file.path().to_path_buf();
         summary.write(file)?;
-        writeln!(out, "summary written to {}", path.display())?;
+        if path.as_os_str() != "-" {
+            writeln!(out, "summary written to {}", path.display())?;
+        }
     }
     failed.map_or(Ok(()), |e| Err(e.into()))
 }
@@ -111,7 +122,9 @@ impl Outputs {
         json: Option<&Path>,
         record: Option<Option<PathBuf>>,
     ) -> Result<Self> {
-        let stream = match json {
+        // the stream of equilibria goes beside a summary file; beside a FIFO,
+        // device or standard output there is nowhere to put it
+        let stream = match json.filter(|p| output_kind(p) == OutputKind::File) {
             Some(p) => {
                 // checked before the work, not after it
                 anyhow::ensure!(
@@ -146,6 +159,10 @@ impl Outputs {
                     json.is_none_or(|j| j != file && j.with_extension("jsonl") != file),
                     "--record {}: the same file as the JSON summary or its stream",
                     file.display()
+                );
+                anyhow::ensure!(
+                    !(file.as_os_str() == "-" && json.is_some_and(|j| j.as_os_str() == "-")),
+                    "--record - and --json -: only one of them can go to standard output"
                 );
                 let text = std::fs::read_to_string(scene_path).unwrap_or_default();
                 Some(Recorder::create(
@@ -235,7 +252,9 @@ fn report(
         return Ok(());
     }
     print_events(&summary.events, out)?;
+    // beside the summary, unless that is no file (then where they go without it)
     let stem = json
+        .filter(|p| output_kind(p) == OutputKind::File)
         .map(Path::to_path_buf)
         .unwrap_or_else(|| PathBuf::from("recordings").join(scene.file_stem("run")));
     let title = format!("{} (N = {})", summary.scene, summary.segments);

@@ -6,6 +6,7 @@ use super::progress::Progress;
 use crate::io::auto::{is_auto_input, read_auto_input};
 use crate::io::convergence_plot::{Series, convergence_plot};
 use crate::io::json::write_pretty;
+use crate::io::output::{OutputKind, output_kind};
 use crate::io::verify_file::read_solutions;
 use crate::model::rod::Parameter;
 use crate::report::auto_events::{self, compare_with_continuation};
@@ -129,6 +130,11 @@ fn parameter(name: &str) -> Result<Parameter> {
 
 /// Run `knotrod verify`.
 pub fn verify(a: Args) -> Result<()> {
+    let dash = |p: &Option<PathBuf>| p.as_deref().is_some_and(|p| p.as_os_str() == "-");
+    ensure!(
+        !(dash(&a.json) && dash(&a.report)),
+        "--json - and --report -: only one of them can go to standard output"
+    );
     let [n1, n2, n3] = a.segments[..] else {
         bail!("--segments: give three resolutions N, 2N, 4N (e.g. 100,200,400)");
     };
@@ -188,7 +194,13 @@ pub fn verify(a: Args) -> Result<()> {
         None => run()?,
     };
     progress.finish();
-    let mut out = std::io::stdout().lock();
+    // a JSON or report on standard output keeps it for itself: the table for
+    // people goes to standard error
+    let mut out: Box<dyn Write> = if dash(&a.json) || dash(&a.report) {
+        Box::new(std::io::stderr().lock())
+    } else {
+        Box::new(std::io::stdout().lock())
+    };
     write!(out, "{}", summary(&checks))?;
     if checks.len() <= 10 {
         for c in &checks {
@@ -207,17 +219,22 @@ pub fn verify(a: Args) -> Result<()> {
     }
     if let Some(p) = &a.json {
         write_pretty(p, &checks)?;
-        eprintln!("wrote {}", p.display());
+        if !dash(&a.json) {
+            eprintln!("wrote {}", p.display());
+        }
     }
     if let Some(p) = &a.report {
         let plot = p.with_extension("svg");
-        let drawn = match convergence_plot(&plot, &series(&checks)) {
-            Ok(()) => true,
-            Err(e) => {
-                eprintln!("no convergence plot: {e}");
-                false
-            }
-        };
+        // drawn beside a report file only (not beside a FIFO, device or `-`)
+        let beside = output_kind(p) == OutputKind::File;
+        let drawn = beside
+            && match convergence_plot(&plot, &series(&checks)) {
+                Ok(()) => true,
+                Err(e) => {
+                    eprintln!("no convergence plot: {e}");
+                    false
+                }
+            };
         let name = plot
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
@@ -238,7 +255,9 @@ pub fn verify(a: Args) -> Result<()> {
             text.push_str(section);
         }
         crate::io::output::write_file(p, text.as_bytes())?;
-        eprintln!("wrote {}", p.display());
+        if !dash(&a.report) {
+            eprintln!("wrote {}", p.display());
+        }
     }
     Ok(())
 }

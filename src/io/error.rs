@@ -47,14 +47,22 @@ pub enum IoError {
         /// What is wrong.
         reason: String,
     },
-    /// The device holding a file is full: the file was not replaced.
+    /// The device holding a file is full: a file was not replaced (a
+    /// stream, FIFO or device written directly holds what came before).
     #[error(
-        "no space left on device: {} not written (a file already there is left as it was)",
-        path.display()
+        "No space left on device: {} {}",
+        path.display(),
+        if *streamed {
+            "was written only in part (written directly: a FIFO, device or standard output)"
+        } else {
+            "not written (a file already there is left as it was)"
+        }
     )]
     NoSpace {
         /// The file being written.
         path: PathBuf,
+        /// Whether it was written directly rather than replaced.
+        streamed: bool,
     },
     /// A file cannot be written: it is a folder, or another writer holds it.
     #[error("{}: {why}", path.display())]

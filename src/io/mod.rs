@@ -50,8 +50,17 @@ pub fn read_limited(path: &std::path::Path, limit: u64) -> std::io::Result<Vec<u
     Ok(bytes)
 }
 
-/// The text of `path` (UTF-8), refused past `limit` bytes (`read_limited`).
+/// The text of `path` (UTF-8, a leading byte-order mark dropped, as
+/// spreadsheets and editors on other systems write one), refused past `limit`
+/// bytes (`read_limited`).
 pub fn read_text(path: &std::path::Path, limit: u64) -> std::io::Result<String> {
-    String::from_utf8(read_limited(path, limit)?)
+    let mut bytes = read_limited(path, limit)?;
+    if bytes.starts_with(UTF8_BOM) {
+        bytes.drain(..UTF8_BOM.len());
+    }
+    String::from_utf8(bytes)
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error()))
 }
+
+/// UTF-8's byte-order mark.
+const UTF8_BOM: &[u8] = "\u{feff}".as_bytes();

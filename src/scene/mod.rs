@@ -806,8 +806,9 @@ fn parse_message(text: &str, e: &toml::de::Error) -> String {
 }
 
 impl Scene {
-    /// Parse and validate scene text.
+    /// Parse and validate scene text (a leading byte-order mark ignored).
     pub fn parse(text: &str) -> Result<Scene, SceneError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
             path: PathBuf::from("<text>"),
             message: parse_message(text, &e),

@@ -9,6 +9,8 @@ use crate::scene::{
 
 /// Most rows of a `model.natural_strains` table.
 pub const MAX_NATURAL_ROWS: usize = 100_000;
+/// Largest `[contact] margin`, in rod lengths.
+pub const MAX_CONTACT_MARGIN: f64 = 0.25;
 
 impl Scene {
     /// Check every value's range (sections in the order of the file).
@@ -829,10 +831,23 @@ impl Scene {
         Ok(())
     }
 
-    /// `[contact]`: a positive margin, finite obstacles.
+    /// `[contact]`: a positive margin no larger than [`MAX_CONTACT_MARGIN`],
+    /// finite obstacles.
     fn check_contact(&self) -> Result<(), SceneError> {
         if let Some(c) = &self.contact {
             positive("contact.margin", c.margin)?;
+            if c.margin > MAX_CONTACT_MARGIN {
+                return Err(invalid(
+                    "contact.margin",
+                    format!(
+                        "must be at most {} rod lengths, got {}: pairs closer than h + margin \
+                         become constraints, so past a quarter of the rod nearly every pair \
+                         of the rod is one (the default is 0.02)",
+                        short(MAX_CONTACT_MARGIN),
+                        short(c.margin)
+                    ),
+                ));
+            }
             for o in &c.obstacles {
                 for v in o {
                     finite("contact.obstacles", *v)?;

@@ -228,12 +228,21 @@ pub fn starting_equilibrium(
         // unfold the double ring quasi-statically: straight from its own
         // clamps (0, 0, 2π) to the scene's
         let ring = Clamps::new(0.0, 0.0, 1.0);
+        let target = scene.clamps();
         let mut state = initial_state(scene, &model)?;
         state.set_clamps(ring);
+        // traced with the scene's clamps, the ring carries their φ as twist:
+        // far from its own φ/2π = 1 it does not relax
         let mut report = newton
             .minimize(&mut state, &scene.solver)
-            .context("the double ring")?;
-        let target = scene.clamps();
+            .with_context(|| {
+                format!(
+                    "the double ring (z* = δ = 0, φ/2π = 1) did not relax from the twist of \
+                     clamps.phi_over_2pi = {}: it is unfolded only to clamps near its own \
+                     (start nearer, or from another shape)",
+                    target.phi_over_2pi()
+                )
+            })?;
         let steps = scene.initial.steps.map_or(40, |s| s as usize);
         for k in 1..=steps {
             let f = k as f64 / steps as f64;
@@ -245,7 +254,16 @@ pub fn starting_equilibrium(
                 ..ring
             };
             let step = crate::study::loading::move_clamps(&mut newton, &state, c, &scene.solver)
-                .with_context(|| format!("unfolding the double ring, step {k} of {steps}"))?;
+                .with_context(|| {
+                    format!(
+                        "unfolding the double ring (z* = δ = 0, φ/2π = 1) to clamps.z_star = {}, \
+                         clamps.delta = {}, clamps.phi_over_2pi = {}: step {k} of {steps} failed \
+                         (the ring may not unfold that far: start nearer, or from another shape)",
+                        target.z_star,
+                        target.delta,
+                        target.phi_over_2pi()
+                    )
+                })?;
             (state, report) = (step.state, step.report);
         }
         return Ok((newton, state, report));

@@ -127,6 +127,9 @@ impl Recorder {
     ) -> Result<Self> {
         let file = Output::create(path)?;
         let mut writer = mcap::WriteOptions::new()
+            // a stream (FIFO, device, standard output) cannot seek back: its
+            // chunks are then assembled in memory
+            .disable_seeking(file.is_stream())
             .profile("")
             .library(format!("knotrod {}", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::new(file))
@@ -175,7 +178,10 @@ impl Recorder {
         r.map_err(|e| {
             let path = self.path.clone();
             let copy = match &e {
-                IoError::NoSpace { .. } => IoError::NoSpace { path },
+                IoError::NoSpace { streamed, .. } => IoError::NoSpace {
+                    path,
+                    streamed: *streamed,
+                },
                 e => IoError::Recording {
                     path,
                     reason: std::error::Error::source(e)
