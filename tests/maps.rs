@@ -68,6 +68,17 @@ fn shards_merge_to_the_single_run_bit_for_bit_and_maps_resume() {
         std::fs::read(&merged).unwrap(),
     );
     assert!(a == b, "merged shards differ from the single run");
+    // merged to standard output: the same bytes there alone (issue 54)
+    let mut dash: Vec<&str> = vec!["merge"];
+    dash.extend(parts.iter().map(|p| p.to_str().unwrap()));
+    dash.extend(["--json", "-"]);
+    let out = knotrod(&dash);
+    assert!(
+        out.status.success() && out.stdout == a,
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!Path::new("-.svg").exists() && !Path::new("-.png").exists());
     let map: serde_json::Value = serde_json::from_slice(&a).unwrap();
     for key in ["boundaries", "grid", "good_area", "bounding_box"] {
         assert!(map.get(key).is_some(), "map lacks {key}");

@@ -3,6 +3,7 @@
 use super::progress::Progress;
 use crate::io::json::write_pretty;
 use crate::io::map_files::{LineFolder, Partial, merge as merge_parts, trace_cached};
+use crate::io::output::{OutputKind, output_kind};
 use crate::scene::MapSpec;
 use crate::scene::{Job, Scene};
 use crate::study::boundary::Traced;
@@ -35,7 +36,7 @@ pub fn map(
     // a map keeps its lines, slices and plots beside its file
     if let Some(p) = &json {
         anyhow::ensure!(
-            crate::io::output::output_kind(p) == crate::io::output::OutputKind::File,
+            output_kind(p) == OutputKind::File,
             "--json {}: a map keeps its computed lines, slices and plots beside its \
              file; name a file (not standard output, a FIFO or a device)",
             p.display()
@@ -220,6 +221,11 @@ fn compute_lines(
 /// Write a plane map to `json`, print it, and draw it beside the file.
 fn write_map(map: &Map, json: &Path) -> Result<()> {
     write_pretty(json, map)?;
+    // a map streamed (`merge --json -`, a FIFO, a device) has no file to draw
+    // its plots beside, and standard output holds the map alone
+    if output_kind(json) == OutputKind::Stream {
+        return Ok(print_map(map, &mut std::io::stderr().lock())?);
+    }
     let mut out = std::io::stdout().lock();
     print_map(map, &mut out)?;
     writeln!(out, "map written to {}", json.display())?;
