@@ -24,6 +24,7 @@ mod maps;
 mod model_parameters;
 mod output_paths;
 mod paper_equilibria;
+mod pictures;
 mod polish;
 mod profile;
 mod recordings;

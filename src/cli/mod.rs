@@ -5,6 +5,7 @@ mod knot;
 mod map;
 mod plot;
 mod progress;
+mod render;
 mod reports;
 mod run;
 pub mod verify;
@@ -65,6 +66,36 @@ pub enum Command {
         /// Output file (default: stdout).
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+    /// Pictures of configurations: the rod as a shaded tube with the yellow
+    /// stripe along d1 (a strip as its ribbon), its clamps, rays and walls.
+    Render {
+        /// A recording (`.mcap`) or a `run --json` summary.
+        input: PathBuf,
+        /// The states, comma-separated, drawn side by side: indices in the
+        /// run, `phi=V` (the state nearest φ/2π = V), or events by label (X,
+        /// W1) or kind (contact_lost, fold:2): the state of the event's branch
+        /// nearest it.
+        #[arg(long, value_delimiter = ',', default_value = "0")]
+        index: Vec<String>,
+        /// Names written under the states (e.g. A,B as the paper's Figure 4),
+        /// comma-separated, one per state (default: the event's label).
+        #[arg(long, value_delimiter = ',')]
+        label: Vec<String>,
+        /// oblique | side | top | AZIMUTH,ELEVATION (degrees).
+        #[arg(long, default_value = "oblique")]
+        view: String,
+        /// WIDTHxHEIGHT of the whole picture, pixels (default 1200x900 for
+        /// one state, 800 wide per state for several).
+        #[arg(long)]
+        size: Option<String>,
+        /// Width a strip is drawn with (default: its scene's strip_width, or
+        /// 0.05 for a strip of zero width).
+        #[arg(long)]
+        strip_width: Option<f64>,
+        /// The picture: NAME.png or NAME.svg.
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Writhe and knot type of any curve (one "x y z" or "x,y,z" point per line).
     Knot {
@@ -168,6 +199,23 @@ pub fn main_with(cli: Cli) -> Result<()> {
             &recording,
             &mut std::io::stdout().lock(),
         )?),
+        Command::Render {
+            input,
+            index,
+            label,
+            view,
+            size,
+            strip_width,
+            out,
+        } => render::render(
+            &input,
+            &index,
+            &label,
+            &view,
+            size.as_deref(),
+            strip_width,
+            &out,
+        ),
         Command::Export {
             recording,
             index,

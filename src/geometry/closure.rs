@@ -26,12 +26,7 @@ pub fn ray_closure(
     } else {
         top_dir.normalize()
     };
-    let trial = if axis.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let side = (trial - trial.dot(&axis) * axis).normalize();
+    let side = super::normal_to(&axis);
     let mut closed = points.to_vec();
     closed.push(top);
     closed.push(top + ray * side);

@@ -14,6 +14,7 @@ pub mod map_files;
 pub mod output;
 pub mod plot;
 pub mod recording;
+pub mod render;
 pub mod scene_file;
 pub mod source_hash;
 pub mod summary;

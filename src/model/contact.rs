@@ -85,12 +85,7 @@ fn pair_gap(p: &[Vector3<f64>; 4], diameter: f64) -> (f64, f64, f64, [Vector3<f6
     } else {
         // coincident: any direction perpendicular to the first segment
         let t = (p[1] - p[0]).normalize();
-        let a = if t.x.abs() < 0.9 {
-            Vector3::x()
-        } else {
-            Vector3::y()
-        };
-        (a - a.dot(&t) * t).normalize()
+        crate::geometry::normal_to(&t)
     };
     (
         d - diameter,

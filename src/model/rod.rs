@@ -918,16 +918,12 @@ impl RodState {
             let t = tangent(&nodes, 0);
             let mut a = d1(0.0);
             a -= a.dot(&t) * t;
-            if a.norm() < 1e-9 {
+            reference[0] = if a.norm() < 1e-9 {
                 // d1 along the edge: any normal will do
-                let e = if t.x.abs() < 0.9 {
-                    Vector3::x()
-                } else {
-                    Vector3::y()
-                };
-                a = e - e.dot(&t) * t;
-            }
-            reference[0] = a.normalize();
+                crate::geometry::normal_to(&t)
+            } else {
+                a.normalize()
+            };
         }
         let free_end = usize::from(ends.end != EndKind::Clamped);
         for j in 1..n + free_end {

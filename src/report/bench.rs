@@ -119,6 +119,7 @@ pub fn run(scenes: &Path) -> Result<Report> {
         let mut push = |name: &str, t: f64| per.entry(name.to_string()).or_default().push((n, t));
         linear_algebra_costs(&d, n, &state, &mut push);
         geometry_costs(&d, &e, &state, &mut push);
+        picture_cost(&d, &e, &mut push);
     }
     let exponents = per
         .iter()
@@ -459,6 +460,37 @@ fn geometry_costs(
         "diagnostics_full",
         per_call(|| {
             Conformation::of(state, &m);
+        }),
+    );
+}
+
+/// Seconds per picture of the state (`knotrod render`'s work less reading
+/// the file): a 1200×900 PNG, oblique, with its clamps, rays and walls.
+fn picture_cost(
+    d: &Scene,
+    e: &crate::analysis::equilibrium::Equilibrium,
+    push: &mut impl FnMut(&str, f64),
+) {
+    use crate::io::render::{Body, Picture, View, png};
+    let c = crate::io::plot::class_colour(e);
+    let body = Body {
+        state: e.state.clone(),
+        diameter: 4.0 / d.rod_model(None).stretching_stiffness.sqrt(),
+        ribbon: None,
+        colour: [c.0, c.1, c.2],
+        label: String::new(),
+        caption: "good knot".into(),
+        contacts: vec![],
+    };
+    let picture = Picture {
+        width: 1200,
+        height: 900,
+        view: View::OBLIQUE,
+    };
+    push(
+        "render_png_1200x900",
+        per_call(|| {
+            png(std::slice::from_ref(&body), &picture).expect("a picture of nonzero size");
         }),
     );
 }

@@ -76,12 +76,7 @@ impl Projection {
     /// seen end-on.
     pub(crate) fn new(closed: &[Vector3<f64>], dir: &Vector3<f64>) -> Result<Self, Degenerate> {
         let v = dir.normalize();
-        let trial = if v.x.abs() < 0.9 {
-            Vector3::x()
-        } else {
-            Vector3::y()
-        };
-        let a = (trial - trial.dot(&v) * v).normalize();
+        let a = crate::geometry::normal_to(&v);
         let b = v.cross(&a);
         let p2: Vec<Vector2<f64>> = closed
             .iter()

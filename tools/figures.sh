@@ -1,0 +1,27 @@
+#!/bin/sh
+# Regenerate the pictures of configurations in docs/figures/ (knotrod render),
+# each from the scene that computes it: Figure 4 (A and B), Figure 5 (a stable
+# unwalled knot at φ/2π ≈ 0.88 and X), Figure 6-right (G, the Appendix D knot),
+# Figure 8-right (the strip knot) and Figure 15 (the Appendix E knot).
+#   KNOTROD=target/debug/knotrod tools/figures.sh   (default: target/release/knotrod)
+set -eu
+K=${KNOTROD:-target/release/knotrod}
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+F=docs/figures
+
+"$K" run scenes/trefoil_contact_start.toml --no-record --json "$T/contact.json" >/dev/null
+"$K" render "$T/contact.json" --index 0,contact_lost --label A,B --out $F/config_fig4_A_B.png
+
+"$K" run scenes/fig3_kirchhoff.toml --record "$T/fig3.mcap" >/dev/null
+"$K" render "$T/fig3.mcap" --index phi=0.88,X --label "φ/2π ≈ 0.88",X --out $F/config_fig5_X.png
+
+"$K" run scenes/appendix_d.toml --record "$T/d.mcap" >/dev/null
+"$K" render "$T/d.mcap" --label G --out $F/config_fig6_G.png
+
+"$K" run scenes/fig8_strip_knot.toml --record "$T/strip.mcap" >/dev/null
+"$K" render "$T/strip.mcap" --label "Figure 8-right" --out $F/config_fig8_strip.png
+
+"$K" run scenes/appendix_e.toml --record "$T/e.mcap" >/dev/null
+"$K" render "$T/e.mcap" --label "Appendix E" --out $F/config_fig15_appendix_e.png
+"$K" render "$T/e.mcap" --label "Appendix E (from above)" --view top --out $F/config_fig15_appendix_e_top.png
