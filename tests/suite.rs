@@ -35,4 +35,5 @@ mod stability;
 mod strip;
 mod strip_shooting;
 mod verify;
+mod vtk_export;
 mod writers;

@@ -210,6 +210,9 @@ def _scene(scene: SceneLike) -> Any:
     return _knotrod.Scene.from_toml(os.fspath(scene))
 
 
+# the state and its model as JSON text: for restarts and exports, not fields
+_TEXTS = ("state_json", "model_json")
+
 _ARRAYS = (
     "nodes",
     "theta",
@@ -289,6 +292,10 @@ class Equilibrium:
             if name not in self._data and self._source is not None:
                 self._data[name] = self._source.state_json(self._index)
             data = self._data
+        elif name == "model_json":
+            if name not in self._data and self._source is not None:
+                self._data[name] = self._source.model_json()
+            data = self._data
         elif name in _ARRAYS:
             data = self._all_loaded()
         else:
@@ -304,6 +311,8 @@ class Equilibrium:
         data = dict(self._all_loaded())
         if "state_json" not in data and self._source is not None:
             data["state_json"] = self._source.state_json(self._index)
+        if "model_json" not in data and self._source is not None:
+            data["model_json"] = self._source.model_json()
         return (type(self), (data,))
 
     def __dir__(self) -> List[str]:
@@ -331,13 +340,40 @@ class Equilibrium:
             return self._source.segments(self._index)
         return len(self._data["s_vertices"])
 
+    def to_vtp(self, path: Optional[PathLike] = None) -> bytes:
+        """The state as VTK PolyData, the bytes of a ``.vtp`` file (written to
+        ``path`` if given), as ``knotrod export --format vtp`` writes it: the
+        centreline r(0), x_1..x_N, r(1) as one line, with point data ``s``,
+        ``tube_radius``, ``d1``, ``d2``, ``d3``, ``strains`` (u1, u2, u3),
+        ``n``, ``m`` (lab frame) and ``n_material``, ``m_material``."""
+        data = _knotrod.vtp(self.model_json, self.state_json)
+        if path is not None:
+            with open(os.fspath(path), "wb") as f:
+                f.write(data)
+        return data
+
+    def to_pyvista(self) -> Any:
+        """The state as a ``pyvista.PolyData`` (needs pyvista): the fields of
+        :meth:`to_vtp` as its point data; ``.tube(scalars="tube_radius",
+        absolute=True)`` draws the rod at its diameter."""
+        try:
+            import pyvista
+        except ImportError as e:
+            raise ImportError("Equilibrium.to_pyvista() needs pyvista: pip install pyvista") from e
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "state.vtp")
+            self.to_vtp(path)
+            return pyvista.read(path)
+
     def scalars(self) -> Dict[str, Any]:
         """The measurements without the arrays."""
-        return {k: v for k, v in self._scalars_loaded().items() if k not in _ARRAYS and k != "state_json"}
+        return {k: v for k, v in self._scalars_loaded().items() if k not in _ARRAYS and k not in _TEXTS}
 
     def to_dict(self) -> Dict[str, Any]:
         """Everything as a plain dict (arrays as numpy arrays)."""
-        return {k: v for k, v in self._all_loaded().items() if k != "state_json"}
+        return {k: v for k, v in self._all_loaded().items() if k not in _TEXTS}
 
     def __repr__(self) -> str:
         d = self._scalars_loaded()

@@ -30,7 +30,7 @@ use numpy::{Element, PyArray1, PyArrayMethods};
 use pyo3::IntoPyObjectExt;
 use pyo3::exceptions::{PyException, PyIndexError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyBytes, PyDict, PyList};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -312,6 +312,11 @@ fn add_arrays(
     Ok(())
 }
 
+/// The rod model as JSON text (what `vtp` reads with a state).
+fn model_json(model: &RodModel) -> String {
+    serde_json::to_string(model).unwrap_or_default()
+}
+
 /// The state as JSON text (what `[initial] shape = "file"` reads).
 fn state_json(state: &knotrod::RodState) -> String {
     serde_json::to_string(state).unwrap_or_default()
@@ -336,6 +341,7 @@ fn equilibrium_dict<'py>(
     let d = scalars_dict(py, eq)?;
     add_arrays(py, &d, model, &eq.state)?;
     d.set_item("state_json", state_json(&eq.state))?;
+    d.set_item("model_json", model_json(model))?;
     Ok(d)
 }
 
@@ -397,6 +403,11 @@ impl PyPoints {
     /// The state of equilibrium `index` as JSON text.
     fn state_json(&self, index: isize) -> PyResult<String> {
         Ok(state_json(&self.at(index)?.state))
+    }
+
+    /// The rod model of the equilibria as JSON text.
+    fn model_json(&self) -> String {
+        model_json(&self.model)
     }
 
     /// The N of equilibrium `index`.
@@ -902,6 +913,7 @@ fn read_recording<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RecordingPart
         let d = to_py(py, scalars)?.cast_into::<PyDict>()?;
         add_arrays(py, &d, &msg.model, &msg.state)?;
         d.set_item("state_json", state_json(&msg.state))?;
+        d.set_item("model_json", model_json(&msg.model))?;
         states.append(d)?;
     }
     Ok((
@@ -910,6 +922,24 @@ fn read_recording<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RecordingPart
         to_py(py, &rec.metadata)?,
         states,
     ))
+}
+
+/// A state of a rod model (both as JSON text) as VTK PolyData, the bytes of
+/// a `.vtp` file (`knotrod export --format vtp`).
+#[pyfunction]
+fn vtp<'py>(py: Python<'py>, model_json: &str, state_json: &str) -> PyResult<Bound<'py, PyBytes>> {
+    let bad = |what: &str, e: serde_json::Error| KnotrodError::new_err(format!("{what}: {e}"));
+    let model: RodModel = serde_json::from_str(model_json).map_err(|e| bad("model_json", e))?;
+    let state: knotrod::RodState =
+        serde_json::from_str(state_json).map_err(|e| bad("state_json", e))?;
+    let bytes = knotrod::io::vtk::vtp(
+        &model,
+        &state,
+        "knotrod state",
+        std::path::Path::new("<state>"),
+    )
+    .map_err(|e| KnotrodError::new_err(e.to_string()))?;
+    Ok(PyBytes::new(py, &bytes))
 }
 
 /// The extension module.
@@ -928,5 +958,6 @@ fn _knotrod(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(verify, m)?)?;
     m.add_function(wrap_pyfunction!(knot_type, m)?)?;
     m.add_function(wrap_pyfunction!(read_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(vtp, m)?)?;
     Ok(())
 }

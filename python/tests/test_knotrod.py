@@ -383,3 +383,29 @@ def test_a_branch_restarts_from_an_equilibrium_handed_back(root):
     with pytest.raises(knotrod.SceneError) as bad:
         knotrod.equilibrium(scene, start="{}")
     assert bad.value.field == "initial.file"
+
+
+def test_vtk_export_and_pyvista(root, tmp_path):
+    # the .vtp of an equilibrium (knotrod export --format vtp), from a solve,
+    # a branch point and a recording alike; pyvista reads it when installed
+    scene = knotrod.Scene.from_toml(root / "scenes/appendix_d.toml")
+    eq = knotrod.equilibrium(scene, segments=40)
+    data = eq.to_vtp(tmp_path / "d.vtp")
+    assert data.startswith(b'<VTKFile type="PolyData"')
+    assert (tmp_path / "d.vtp").read_bytes() == data
+    assert "model_json" not in eq.scalars() and "model_json" not in eq.to_dict()
+    rec = knotrod.read_recording(root / "recordings/samples/fig3_n60.mcap")
+    assert rec.states[5].to_vtp().startswith(b'<VTKFile type="PolyData"')
+    pv = pytest.importorskip("pyvista", reason="pyvista is not installed: Equilibrium.to_pyvista() untested")
+    mesh = eq.to_pyvista()
+    assert isinstance(mesh, pv.PolyData) and mesh.n_points == 42 and mesh.n_lines == 1
+    for name in ["s", "tube_radius", "d1", "d2", "d3", "strains", "n", "m", "n_material", "m_material"]:
+        assert name in mesh.point_data, name
+    # the interior points are the nodes, their strains the vertices'
+    np.testing.assert_array_equal(mesh.points[1:-1], eq.nodes[1:-1])
+    np.testing.assert_array_equal(mesh.point_data["strains"][1:-1], eq.strains)
+    assert np.allclose(mesh.point_data["tube_radius"], 0.0025)
+    # a weightless rod carries one force vector along its length
+    force = mesh.point_data["n"]
+    assert np.abs(force - force[0]).max() < 1e-7 * np.linalg.norm(force[0])
+    assert mesh.tube(scalars="tube_radius", absolute=True).n_points > 42

@@ -60,7 +60,7 @@ pub enum Command {
         /// Index of the state.
         #[arg(long, default_value_t = 0)]
         index: u64,
-        /// csv | json | obj.
+        /// csv | json | obj | shooting | vtp | pvd (every state, --out NAME.pvd).
         #[arg(long, value_enum, default_value = "csv")]
         format: ExportFormat,
         /// Output file (default: stdout).

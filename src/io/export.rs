@@ -17,6 +17,12 @@ pub enum ExportFormat {
     /// Its shooting unknowns, polished on the continuum equations, as a
     /// `[[solution]]` of a `knotrod verify` file.
     Shooting,
+    /// VTK PolyData (ParaView, pyvista): the centreline with the tube's
+    /// radius, s, the material frame, the strains, n and m as point data.
+    Vtp,
+    /// Every state of the recording as a VTK time series: `--out NAME.pvd`
+    /// and one `NAME_K.vtp` beside it per state (`--index` is not used).
+    Pvd,
 }
 
 /// Print what a recording holds.
@@ -74,23 +80,69 @@ fn print_info(
     Ok(())
 }
 
-/// Export one recorded state.
+/// Export one recorded state (every state, for `Pvd`).
 pub fn export(path: &Path, index: u64, format: ExportFormat, out: Option<&Path>) -> Result<()> {
+    if let ExportFormat::Pvd = format {
+        return series(path, out);
+    }
     let msg = read_state(path, index)?;
+    if let ExportFormat::Vtp = format {
+        let title = format!("knotrod state {index} of {}", path.display());
+        let bytes = crate::io::vtk::vtp(&msg.model, &msg.state, &title, path)?;
+        return write_out(out, &bytes);
+    }
     let text = match format {
         ExportFormat::Json => serde_json::to_string_pretty(&msg)
             .map_err(IoError::json("cannot encode the state as JSON", path))?,
         ExportFormat::Csv => csv(&msg),
         ExportFormat::Obj => obj(&msg, path, index),
         ExportFormat::Shooting => shooting(&msg, path, index)?,
+        ExportFormat::Vtp | ExportFormat::Pvd => unreachable!("written above"),
     };
+    write_out(out, text.as_bytes())
+}
+
+/// Write `bytes` to `out`, or to standard output.
+fn write_out(out: Option<&Path>, bytes: &[u8]) -> Result<()> {
     match out {
-        Some(p) => crate::io::output::write_file(p, text.as_bytes()),
+        Some(p) => crate::io::output::write_file(p, bytes),
         None => std::io::stdout()
             .lock()
-            .write_all(text.as_bytes())
+            .write_all(bytes)
             .map_err(IoError::Output),
     }
+}
+
+/// Every state of a recording as `.vtp` files beside the collection `out`
+/// (`NAME.pvd`), the state's index as time; the collection is written last,
+/// so it lists only files that are there.
+fn series(path: &Path, out: Option<&Path>) -> Result<()> {
+    let Some(out) = out.filter(|p| p.extension().is_some_and(|e| e == "pvd")) else {
+        return Err(IoError::Recording {
+            path: path.into(),
+            reason: "--format pvd writes a collection and a file per state: name it with \
+                     --out NAME.pvd"
+                .into(),
+        });
+    };
+    let bytes = crate::io::read_limited(path, crate::io::DATA_FILE_LIMIT)
+        .map_err(IoError::file("cannot read recording", path))?;
+    let stem = out
+        .file_stem()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .into_owned();
+    let dir = out.parent().unwrap_or(Path::new(""));
+    let mut parts = Vec::new();
+    crate::io::recording::each_state(path, &bytes, |msg| {
+        let file = format!("{stem}_{:05}.vtp", msg.index);
+        let title = format!("knotrod state {} of {}", msg.index, path.display());
+        let vtp = crate::io::vtk::vtp(&msg.model, &msg.state, &title, path)?;
+        crate::io::output::write_file(&dir.join(&file), &vtp)?;
+        parts.push((msg.index as f64, file));
+        Ok(())
+    })?;
+    crate::io::output::write_file(out, crate::io::vtk::collection(&parts).as_bytes())
 }
 
 /// Nodes and material frames, one row per node.

@@ -19,6 +19,7 @@ pub mod scene_file;
 pub mod source_hash;
 pub mod summary;
 pub mod verify_file;
+pub mod vtk;
 
 pub use error::IoError;
 

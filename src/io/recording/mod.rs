@@ -16,5 +16,5 @@ pub use foxglove::scene_update;
 pub use messages::{
     EVENTS_TOPIC, SCALARS_TOPIC, SCENE_TOPIC, STATE_TOPIC, Scalars, StateMessage, TF_TOPIC,
 };
-pub use reader::{Recording, parse_recording, parse_state, read_recording, read_state};
+pub use reader::{Recording, each_state, parse_recording, parse_state, read_recording, read_state};
 pub use writer::Recorder;

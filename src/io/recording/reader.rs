@@ -178,6 +178,25 @@ pub fn read_state(path: &Path, index: u64) -> Result<StateMessage> {
     parse_state(path, &read_bytes(path)?, index)
 }
 
+/// Every state of a recording's `bytes`, in file order, handed to `on`
+/// (`path` names the file in errors): one pass over the file.
+pub fn each_state(
+    path: &Path,
+    bytes: &[u8],
+    mut on: impl FnMut(StateMessage) -> Result<()>,
+) -> Result<()> {
+    each_record(path, bytes, |item| match item {
+        Item::Message {
+            topic: STATE_TOPIC,
+            data,
+        } => {
+            on(serde_json::from_slice(data)
+                .map_err(IoError::json("malformed state message", path))?)
+        }
+        _ => Ok(()),
+    })
+}
+
 /// The state with index `index` of a recording's `bytes` (`path` names it in
 /// errors).
 pub fn parse_state(path: &Path, bytes: &[u8], index: u64) -> Result<StateMessage> {
