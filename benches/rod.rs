@@ -137,7 +137,7 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("figure_3_branch");
     g.sample_size(10);
     g.bench_function("200", |b| {
-        b.iter(|| knotrod::study::run::run_scene(&fig3, Some(200), &mut |_| Ok(())).unwrap())
+        b.iter(|| knotrod::study::run::run_scene(&fig3, Some(200), &mut ()).unwrap())
     });
     g.finish();
 }

@@ -286,7 +286,7 @@ fn a_loading_step_that_runs_out_of_its_budget_says_which_step() {
     let path = "[[loading]]\nz_star = 0.5\nsteps = 2\n";
     let run = |extra: &str| {
         let scene = Scene::parse(&format!("{GOOD}{path}{extra}")).unwrap();
-        knotrod::study::run::run_scene(&scene, None, &mut |_| Ok(()))
+        knotrod::study::run::run_scene(&scene, None, &mut ())
     };
     // the default budget is ample
     run("").unwrap();

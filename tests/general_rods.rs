@@ -270,10 +270,14 @@ fn the_appendix_d_knot_continued_in_its_weight_agrees_with_shooting_at_second_or
             .replace("[solver]", "[load]\nweight = 0.0\ndirection = [-1.0, 0.0, 0.0]\n[[loading]]\ntargets = { weight = 25.0 }\nsteps = 25\n[solver]");
         let scene = Scene::parse(&text).unwrap();
         let mut last = None;
-        knotrod::study::run::run_scene(&scene, None, &mut |e| {
-            last = Some(e);
-            Ok(())
-        })
+        knotrod::study::run::run_scene(
+            &scene,
+            None,
+            &mut knotrod::study::observer::equilibria(|e| {
+                last = Some(e);
+                Ok(())
+            }),
+        )
         .unwrap();
         let last = last.unwrap();
         let w = knotrod::model::rod::Parameter::Weight.value(&last.state.clamps);

@@ -156,6 +156,24 @@ fn island_boundary_traced_directly_agrees_with_the_grid() {
     let map: serde_json::Value = map_json(&scene, &dir.join("trace.json"));
     let traced = &map["traced"];
     assert_eq!(traced["closed"], true, "{}", traced["stopped"]);
+    // `plot` draws a map file as its map: the classes' legend, the curves named
+    let stem = dir.join("replot");
+    knotrod_ok(&[
+        "plot",
+        dir.join("trace.json").to_str().unwrap(),
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    let svg = std::fs::read_to_string(stem.with_extension("svg")).unwrap();
+    let texts: Vec<&str> = svg
+        .split("<text")
+        .skip(1)
+        .filter_map(|t| t.split('>').nth(1)?.split('<').next())
+        .map(str::trim)
+        .collect();
+    for name in ["good knot", "S", "W1", "W2", "X"] {
+        assert!(texts.contains(&name), "{name} missing from {texts:?}");
+    }
     // Figure 7-left: the island is bounded by S, W1, W2 and X
     let mut labels: Vec<&str> = traced["pieces"]
         .as_array()

@@ -17,7 +17,7 @@ use std::path::Path;
 
 fn polished_events(n: usize) -> (Scene, Vec<Event>) {
     let scene = Scene::load(Path::new("scenes/fig3_polished.toml")).unwrap();
-    let events = run_scene(&scene, Some(n), &mut |_| Ok(())).unwrap();
+    let events = run_scene(&scene, Some(n), &mut ()).unwrap();
     (scene, events)
 }
 

@@ -22,6 +22,7 @@ mod knots;
 mod map_general;
 mod maps;
 mod model_parameters;
+mod observer;
 mod output_paths;
 mod paper_equilibria;
 mod pictures;

@@ -1,8 +1,10 @@
 #!/bin/sh
-# Regenerate the pictures of configurations in docs/figures/ (knotrod render),
-# each from the scene that computes it: Figure 4 (A and B), Figure 5 (a stable
-# unwalled knot at φ/2π ≈ 0.88 and X), Figure 6-right (G, the Appendix D knot),
-# Figure 8-right (the strip knot) and Figure 15 (the Appendix E knot).
+# Regenerate docs/figures/, each picture from the scene that computes it:
+# the pictures of configurations (knotrod render) of Figure 4 (A and B),
+# Figure 5 (a stable unwalled knot at φ/2π ≈ 0.88 and X), Figure 6-right (G,
+# the Appendix D knot), Figure 8-right (the strip knot) and Figure 15 (the
+# Appendix E knot); then the diagrams of branches, loading paths and maps,
+# named <scene>_n<N>.png (fig9_strip_3d's 3D map, hours of CPU, is not redone).
 #   KNOTROD=target/debug/knotrod tools/figures.sh   (default: target/release/knotrod)
 set -eu
 K=${KNOTROD:-target/release/knotrod}
@@ -25,3 +27,17 @@ F=docs/figures
 "$K" run scenes/appendix_e.toml --record "$T/e.mcap" >/dev/null
 "$K" render "$T/e.mcap" --label "Appendix E" --out $F/config_fig15_appendix_e.png
 "$K" render "$T/e.mcap" --label "Appendix E (from above)" --view top --out $F/config_fig15_appendix_e_top.png
+
+# diagrams: the PNG a run or map writes beside its --json
+for s in fig3_kirchhoff:200 fig6_kirchhoff:200 fig8_strip:100 fig13_asymptotics:100 \
+         loading_twist_snap:100 trefoil_contact_start:100; do
+    name=${s%%:*}; n=${s##*:}
+    "$K" run scenes/$name.toml --segments "$n" --no-record --json "$T/$name.json" >/dev/null
+    cp "$T/$name.png" "$F/${name}_n$n.png"
+    echo "diagram written to $F/${name}_n$n.png"
+done
+for name in fig7_island_kirchhoff fig7_island_strip; do
+    "$K" map scenes/$name.toml --segments 100 --json "$T/$name.map.json" >/dev/null
+    cp "$T/$name.png" "$F/${name}_n100.png"
+    echo "map written to $F/${name}_n100.png"
+done

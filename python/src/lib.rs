@@ -533,7 +533,13 @@ fn run<'py>(
             error: None,
         };
         let mut record_error = None;
-        let result = knotrod::run_scene(s, segments, &mut |eq: Equilibrium| {
+        // the events as located: an interrupted run keeps those it passed
+        let mut located: Vec<Event> = Vec::new();
+        let on_event = |e: &Event| {
+            located.push(e.clone());
+            Ok(())
+        };
+        let on_equilibrium = |eq: Equilibrium| {
             if let Some(r) = recorder.as_mut()
                 && let Err(e) = r.record(&eq)
             {
@@ -557,10 +563,19 @@ fn run<'py>(
                 return Err(StudyError::Observer(format!("recording: {e}").into()));
             }
             told
-        });
+        };
+        let result = knotrod::run_scene(
+            s,
+            segments,
+            &mut knotrod::study::observer::both(on_equilibrium, on_event),
+        );
         match result {
             Ok(events) => out.events = events,
-            Err(e) => out.error = Some(e),
+            Err(e) => {
+                knotrod::analysis::event::label_events(&mut located);
+                out.events = located;
+                out.error = Some(e);
+            }
         }
         out
     })?;

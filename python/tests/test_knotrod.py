@@ -208,6 +208,29 @@ def test_a_progress_callback_that_raises_stops_the_run(root):
     assert len(e.value.partial) == 4
 
 
+def test_an_interrupted_branch_keeps_the_events_it_passed(root, tmp_path):
+    # Figure 3 at N = 60 passes W2 and X going up in φ before its 40th point:
+    # the partial branch and its recording keep them
+    scene = knotrod.Scene.from_toml(root / "scenes/fig3_kirchhoff.toml")
+    full = knotrod.branch(scene, segments=60)
+    upto = [e for e in full.events if e.phi_over_2pi > 0.802 and e.branch == 0]
+    assert {e.label for e in upto} >= {"W2", "X"}
+
+    def stop(point):
+        if point["index"] == 40:
+            raise RuntimeError("enough")
+
+    record = tmp_path / "partial.mcap"
+    with pytest.raises(RuntimeError, match="enough") as e:
+        knotrod.branch(scene, segments=60, progress=stop, record=str(record))
+    partial = e.value.partial
+    # the same events (labels are counted among those found: the partial's
+    # only wall event is its W1)
+    passed = {(ev.kind, round(ev.phi_over_2pi, 9)) for ev in partial.events if ev.label}
+    assert {(ev.kind, round(ev.phi_over_2pi, 9)) for ev in upto if ev.label in ("W2", "X")} <= passed
+    assert len(knotrod.read_recording(record).events) == len(partial.events)
+
+
 CHILD = r"""
 import signal, sys, knotrod
 # a child started from a non-interactive shell's background job inherits

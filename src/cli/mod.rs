@@ -114,7 +114,8 @@ pub enum Command {
     },
     /// Redraw the bifurcation diagram of a run's JSON summary or MCAP recording.
     Plot {
-        /// The summary (`run --json`) or recording (`.mcap`).
+        /// The summary (`run --json`), recording (`.mcap`) or map file
+        /// (`map --json`).
         summary: PathBuf,
         /// Output stem (default: the summary's path without extension).
         #[arg(long)]

@@ -1,8 +1,10 @@
-//! `knotrod plot`: redraw the bifurcation diagram of a summary or recording.
+//! `knotrod plot`: redraw the bifurcation diagram of a summary or recording,
+//! or the map of a map file.
 
 use crate::analysis::event::Event;
-use crate::io::plot::{PlotPoint, bifurcation_diagram};
+use crate::io::plot::{PlotPoint, bifurcation_diagram, island_map, island_slices};
 use crate::io::summary::Summary;
+use crate::study::map::{Map, Map3};
 use anyhow::{Context, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -11,12 +13,23 @@ use std::path::{Path, PathBuf};
 /// recording) to `out` (default: its path without extension).
 pub fn plot(summary: &Path, out: Option<PathBuf>) -> Result<()> {
     let stem = out.unwrap_or_else(|| summary.with_extension(""));
-    let (title, points, events) = if summary.extension().is_some_and(|e| e == "mcap") {
-        from_recording(summary)?
+    let written = if summary.extension().is_some_and(|e| e == "mcap") {
+        let (title, points, events) = from_recording(summary)?;
+        bifurcation_diagram(&stem, &title, &points, &events)?
     } else {
-        from_summary(summary)?
+        let text = crate::io::read_text(summary, crate::io::DATA_FILE_LIMIT)
+            .with_context(|| format!("cannot read {}", summary.display()))?;
+        // a map file (`knotrod map`) is drawn as its map
+        if let Ok(map) = serde_json::from_str::<Map>(&text) {
+            island_map(&stem, &map)?
+        } else if let Ok(map) = serde_json::from_str::<Map3>(&text) {
+            island_slices(&stem, &map)?
+        } else {
+            let (title, points, events) = from_summary(summary, &text)?;
+            bifurcation_diagram(&stem, &title, &points, &events)?
+        }
     };
-    for f in bifurcation_diagram(&stem, &title, &points, &events)? {
+    for f in written {
         writeln!(std::io::stdout().lock(), "plot written to {}", f.display())?;
     }
     Ok(())
@@ -34,12 +47,14 @@ fn from_recording(path: &Path) -> Result<(String, Vec<PlotPoint>, Vec<Event>)> {
     Ok((title, points, rec.events))
 }
 
-/// Title, points and events of a JSON summary.
-fn from_summary(path: &Path) -> Result<(String, Vec<PlotPoint>, Vec<Event>)> {
-    let text = crate::io::read_text(path, crate::io::DATA_FILE_LIMIT)
-        .with_context(|| format!("cannot read {}", path.display()))?;
-    let s: Summary = serde_json::from_str(&text)
-        .with_context(|| format!("{} is not a knotrod summary", path.display()))?;
+/// Title, points and events of a JSON summary (`text`, read from `path`).
+fn from_summary(path: &Path, text: &str) -> Result<(String, Vec<PlotPoint>, Vec<Event>)> {
+    let s: Summary = serde_json::from_str(text).with_context(|| {
+        format!(
+            "{} is neither a knotrod summary nor a map file",
+            path.display()
+        )
+    })?;
     let points = s.equilibria.iter().map(PlotPoint::from).collect();
     Ok((
         format!("{} (N = {})", s.scene, s.segments),

@@ -12,6 +12,7 @@ use crate::io::summary::{Summary, print_equilibrium, print_events};
 use crate::model::rod::RodModel;
 use crate::scene::{Job, Scene};
 use crate::study::error::StudyError;
+use crate::study::observer::Observer;
 use crate::study::run::run_scene;
 use anyhow::Result;
 use std::io::{BufWriter, Write};
@@ -51,19 +52,14 @@ pub fn run(
     let mut summary = Summary::new(&scene, &model);
     let mut outputs = Outputs::open(path, &scene, &model, json.as_deref(), record)?;
     let progress = Progress::spinner("equilibria");
-    let result = run_scene(&scene, segments, &mut |eq: Equilibrium| {
-        outputs
-            .equilibrium(&eq)
-            .map_err(|e| StudyError::Observer(e.into()))?;
-        progress.item(describe(&eq));
-        summary.equilibria.push(eq);
-        if INTERRUPTED.load(Ordering::SeqCst) {
-            return Err(StudyError::Observer(
-                "interrupted (Ctrl-C): stopped after this equilibrium".into(),
-            ));
-        }
-        Ok(())
-    });
+    let mut watch = Watch {
+        outputs: &mut outputs,
+        progress: &progress,
+        summary: &mut summary,
+        events: Vec::new(),
+    };
+    let result = run_scene(&scene, segments, &mut watch);
+    let mut located = watch.events;
     progress.finish();
     let mut out: Box<dyn Write> = if on_stdout {
         Box::new(std::io::stderr().lock())
@@ -84,7 +80,12 @@ pub fn run(
             summary.events = events;
             None
         }
-        Err(e) => Some(e),
+        Err(e) => {
+            // stopped early: the events it passed, labelled among themselves
+            crate::analysis::event::label_events(&mut located);
+            summary.events = located;
+            Some(e)
+        }
     };
     // the recording, the stream and the summary are finalised whatever
     // happened, with what was computed
@@ -98,6 +99,37 @@ pub fn run(
         }
     }
     failed.map_or(Ok(()), |e| Err(e.into()))
+}
+
+/// The run's observer: each equilibrium to the outputs, the progress
+/// display and the summary; a Ctrl-C stops the run after the equilibrium.
+struct Watch<'a> {
+    outputs: &'a mut Outputs,
+    progress: &'a Progress,
+    summary: &'a mut Summary,
+    /// The events as located: a run stopped early keeps those it passed.
+    events: Vec<Event>,
+}
+
+impl Observer for Watch<'_> {
+    fn equilibrium(&mut self, eq: Equilibrium) -> Result<(), StudyError> {
+        self.outputs
+            .equilibrium(&eq)
+            .map_err(|e| StudyError::Observer(e.into()))?;
+        self.progress.item(describe(&eq));
+        self.summary.equilibria.push(eq);
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            return Err(StudyError::Observer(
+                "interrupted (Ctrl-C): stopped after this equilibrium".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    fn event(&mut self, e: &Event) -> Result<(), StudyError> {
+        self.events.push(e.clone());
+        Ok(())
+    }
 }
 
 /// Where a run's equilibria go as they are computed: one JSON line each to

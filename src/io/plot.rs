@@ -76,6 +76,10 @@ pub struct PlotPoint {
     pub branch: usize,
     /// Leg.
     pub leg: usize,
+    /// z* (to name branches at several z*).
+    pub z_star: f64,
+    /// δ.
+    pub delta: f64,
 }
 
 impl From<&Equilibrium> for PlotPoint {
@@ -89,6 +93,8 @@ impl From<&Equilibrium> for PlotPoint {
             min_self_distance: e.min_self_distance,
             branch: e.branch,
             leg: e.leg,
+            z_star: e.z_star,
+            delta: e.delta,
         }
     }
 }
@@ -137,6 +143,257 @@ pub(crate) fn font_available() -> bool {
     })
 }
 
+/// The paper's classes as the legend names them, in its order.
+const LEGEND: [(Class, &str); 4] = [
+    (Class::Good, "good knot"),
+    (Class::StableUnwalled, "stable knot, not walled"),
+    (Class::Unknotted, "unknotted"),
+    (Class::Unstable, "unstable"),
+];
+
+/// The title and, below it, the legend of the classes present (a line
+/// sample in each class's colour and its name), centred in `head`.
+fn draw_head<DB: DrawingBackend>(
+    head: &DrawingArea<DB, Shift>,
+    title: &str,
+    present: &[RGBColor],
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
+    let width = head.dim_in_pixel().0 as i32;
+    let centred = |s: TextStyle<'static>| {
+        s.pos(plotters::style::text_anchor::Pos::new(
+            plotters::style::text_anchor::HPos::Center,
+            plotters::style::text_anchor::VPos::Top,
+        ))
+    };
+    head.draw(&Text::new(
+        title.to_string(),
+        (width / 2, 6),
+        centred(("sans-serif", 18).into_font().color(&BLACK)),
+    ))
+    .map_err(err)?;
+    let font = ("sans-serif", 13).into_font().color(&BLACK);
+    let entries: Vec<(RGBColor, &str, i32)> = LEGEND
+        .iter()
+        .map(|(c, name)| (colour_of(*c), *name))
+        .filter(|(c, _)| present.contains(c))
+        .map(|(c, name)| {
+            let w = head
+                .estimate_text_size(name, &font)
+                .map_or(8 * name.len() as u32, |s| s.0);
+            (c, name, w as i32)
+        })
+        .collect();
+    let sample = 26;
+    let gap = 22;
+    let total: i32 = entries.iter().map(|e| sample + 6 + e.2).sum::<i32>()
+        + gap * (entries.len() as i32 - 1).max(0);
+    let mut x = (width - total) / 2;
+    let y = 38;
+    for (c, name, w) in entries {
+        head.draw(&PathElement::new(
+            vec![(x, y), (x + sample, y)],
+            c.stroke_width(3),
+        ))
+        .map_err(err)?;
+        head.draw(&Text::new(
+            name.to_string(),
+            (x + sample + 6, y - 7),
+            font.clone(),
+        ))
+        .map_err(err)?;
+        x += sample + 6 + w + gap;
+    }
+    Ok(())
+}
+
+/// A label to place beside a point (pixels), clear of the others.
+struct Label {
+    text: String,
+    at: (i32, i32),
+}
+
+/// Write `labels` on `area` beside their points: each at the first of a few
+/// positions around its point that stays inside `frame` (pixels: x0, y0, x1,
+/// y1) and clear of the labels already placed and of every labelled point;
+/// so no label is clipped at the frame or written over another.
+fn place_labels<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    labels: &[Label],
+    frame: (i32, i32, i32, i32),
+    font: &TextStyle,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
+    type Rect = (i32, i32, i32, i32);
+    let overlaps = |a: &Rect, b: &Rect| a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
+    let dots: Vec<Rect> = labels
+        .iter()
+        .map(|l| (l.at.0 - 5, l.at.1 - 5, l.at.0 + 5, l.at.1 + 5))
+        .collect();
+    let mut placed: Vec<Rect> = Vec::new();
+    let mut written: Vec<(&str, (i32, i32))> = Vec::new();
+    for l in labels {
+        // the same event located on two branches at one point: named once
+        let near = |p: &(i32, i32)| (p.0 - l.at.0).abs() + (p.1 - l.at.1).abs() < 8;
+        if written.iter().any(|(t, p)| *t == l.text && near(p)) {
+            continue;
+        }
+        written.push((&l.text, l.at));
+        let (w, h) = area
+            .estimate_text_size(&l.text, font)
+            .map_or((8 * l.text.len() as i32, 14), |s| (s.0 as i32, s.1 as i32));
+        let (x, y) = l.at;
+        // beside the point first, then further up and down, a line at a time
+        let mut offsets = vec![
+            (7, -h - 3),
+            (7, 3),
+            (-w - 7, -h - 3),
+            (-w - 7, 3),
+            (-w / 2, -h - 8),
+            (-w / 2, 8),
+        ];
+        for r in 1..8 {
+            let step = r * (h + 2);
+            for dx in [7, -w - 7, -w / 2] {
+                offsets.push((dx, -h - 3 - step));
+                offsets.push((dx, 3 + step));
+            }
+        }
+        let inside =
+            |r: &Rect| r.0 >= frame.0 && r.1 >= frame.1 && r.2 <= frame.2 && r.3 <= frame.3;
+        let boxes: Vec<Rect> = offsets
+            .iter()
+            .map(|(dx, dy)| (x + dx, y + dy, x + dx + w, y + dy + h))
+            .collect();
+        let free = |r: &Rect| {
+            inside(r)
+                && !placed.iter().any(|p| overlaps(p, r))
+                && !dots.iter().any(|d| overlaps(d, r))
+        };
+        // else the first inside the frame, else pushed into it
+        let chosen = boxes
+            .iter()
+            .find(|r| free(r))
+            .or_else(|| boxes.iter().find(|r| inside(r)))
+            .copied()
+            .unwrap_or_else(|| {
+                let bx = (x + 7).clamp(frame.0, (frame.2 - w).max(frame.0));
+                let by = (y - h - 3).clamp(frame.1, (frame.3 - h).max(frame.1));
+                (bx, by, bx + w, by + h)
+            });
+        // on a white ground, so a curve under it does not cross it out
+        area.draw(&Rectangle::new(
+            [(chosen.0 - 2, chosen.1 - 1), (chosen.2 + 2, chosen.3 + 1)],
+            WHITE.mix(0.8).filled(),
+        ))
+        .map_err(err)?;
+        area.draw(&Text::new(
+            l.text.clone(),
+            (chosen.0, chosen.1),
+            font.clone(),
+        ))
+        .map_err(err)?;
+        placed.push(chosen);
+    }
+    Ok(())
+}
+
+/// The scale of the lowest ω² panel: a symmetric logarithm (linear within
+/// ±c, logarithmic beyond, c three decades below the largest |ω²|) where the
+/// values change sign or span decades, so the sign changes (S, folds) show
+/// beside values in the thousands; else linear.
+#[derive(Clone, Copy, Debug)]
+struct SymLog {
+    c: f64,
+    linear: bool,
+}
+
+impl SymLog {
+    fn for_values(v: &[f64]) -> SymLog {
+        let top = v.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        let low = v.iter().map(|x| x.abs()).fold(f64::INFINITY, f64::min);
+        let one_sign = v.iter().all(|x| *x > 0.0) || v.iter().all(|x| *x < 0.0);
+        let c = if top > 0.0 {
+            10f64.powf(top.log10().floor() - 3.0)
+        } else {
+            1.0
+        };
+        SymLog {
+            c,
+            linear: one_sign && top < 10.0 * low,
+        }
+    }
+    fn to(&self, v: f64) -> f64 {
+        if self.linear {
+            return v;
+        }
+        v.signum() * (v.abs() / self.c).ln_1p() / std::f64::consts::LN_10
+    }
+    fn from(&self, t: f64) -> f64 {
+        if self.linear {
+            return t;
+        }
+        t.signum() * self.c * (t.abs() * std::f64::consts::LN_10).exp_m1()
+    }
+    /// The axis's ticks within (lo, hi) (transformed), nearest zero first:
+    /// 0 and ±{1, 2, 5}·c·10^k, or (linear) multiples of a round step.
+    fn ticks(&self, lo: f64, hi: f64) -> Vec<f64> {
+        let mut keys = Vec::new();
+        if self.linear {
+            let raw = (hi - lo) / 5.0;
+            let decade = 10f64.powf(raw.log10().floor());
+            let step = [1.0, 2.0, 5.0, 10.0]
+                .into_iter()
+                .map(|m| m * decade)
+                .find(|s| *s >= raw)
+                .unwrap_or(10.0 * decade);
+            let mut k = (lo / step).ceil();
+            while k * step < hi {
+                keys.push(k * step);
+                k += 1.0;
+            }
+        } else {
+            keys.push(0.0);
+            for k in 0..12 {
+                for m in [1.0, 2.0, 5.0] {
+                    let v = m * self.c * 10f64.powi(k);
+                    keys.extend([self.to(v), self.to(-v)]);
+                }
+            }
+        }
+        keys.retain(|t| *t > lo && *t < hi);
+        keys.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
+        keys
+    }
+}
+
+/// A tick value, briefly: 3 significant digits, powers of ten as 1e4 past
+/// four digits.
+fn tick_text(v: f64) -> String {
+    // an axis's zero comes as a rounding residue (−6e−17)
+    if v.abs() < 1e-12 {
+        return "0".into();
+    }
+    let a = v.abs();
+    if (1e-3..1e4).contains(&a) {
+        let digits = (2 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{v:.digits$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    } else {
+        format!("{v:.0e}")
+    }
+}
+
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
@@ -146,27 +403,55 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE)
-        .map_err(|e| IoError::Plot(format!("{e:?}")))?;
-    let (top, bottom) = root.split_vertically((root.dim_in_pixel().1 as f64 * 0.55) as u32);
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
+    root.fill(&WHITE).map_err(err)?;
+    let mut present: Vec<RGBColor> = Vec::new();
+    for e in eqs {
+        if !present.contains(&e.colour) {
+            present.push(e.colour);
+        }
+    }
+    // branches at several values of a second parameter (Figure 6) are named
+    // under the legend, in the order of their folds
+    let names = branch_names(eqs);
+    let (head, body) = root.split_vertically(if names.is_empty() { 56 } else { 76 });
+    draw_head(&head, title, &present)?;
+    if !names.is_empty() {
+        head.draw(&Text::new(
+            names,
+            (head.dim_in_pixel().0 as i32 / 2, 54),
+            ("sans-serif", 13).into_font().color(&BLACK).pos(
+                plotters::style::text_anchor::Pos::new(
+                    plotters::style::text_anchor::HPos::Center,
+                    plotters::style::text_anchor::VPos::Top,
+                ),
+            ),
+        ))
+        .map_err(err)?;
+    }
+    let (top, bottom) = body.split_vertically((body.dim_in_pixel().1 as f64 * 0.55) as u32);
     let (mid, low) = bottom.split_vertically(bottom.dim_in_pixel().1 / 2);
     let finite = |v: f64| v.is_finite();
     let xs: Vec<f64> = eqs.iter().map(|e| e.phi_over_2pi).collect();
     let (x0, x1) = bounds(&xs);
     let tw: Vec<f64> = eqs.iter().map(|e| e.twist).collect();
     let (y0, y1) = bounds(&tw);
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
+    // one width for the three panels' tick labels, so their x axes align
+    let y_area = 78;
     let mut chart = ChartBuilder::on(&top)
-        .caption(title, ("sans-serif", 18))
         .margin(8)
-        .x_label_area_size(30)
-        .y_label_area_size(50)
+        .margin_right(18)
+        .x_label_area_size(34)
+        .y_label_area_size(y_area)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
     chart
         .configure_mesh()
         .x_desc("φ/2π")
         .y_desc("Tw")
+        .x_label_formatter(&|v| tick_text(*v))
+        .y_label_formatter(&|v| tick_text(*v))
+        .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(err)?;
     for leg in legs(eqs) {
@@ -188,48 +473,113 @@ where
                 .map_err(err)?;
         }
     }
-    for e in events.iter().filter(|e| !e.label.is_empty()) {
-        chart
-            .draw_series(std::iter::once(Circle::new(
-                (e.phi_over_2pi, e.twist),
-                4,
-                BLACK.filled(),
-            )))
-            .map_err(err)?;
-        chart
-            .draw_series(std::iter::once(Text::new(
-                e.label.clone(),
-                (e.phi_over_2pi, e.twist),
-                ("sans-serif", 14).into_font().color(&BLACK),
-            )))
-            .map_err(err)?;
-    }
-    // lowest ω² (signed log scale would hide the crossing: plot it linearly, clipped)
+    let labelled: Vec<&Event> = events.iter().filter(|e| !e.label.is_empty()).collect();
+    chart
+        .draw_series(
+            labelled
+                .iter()
+                .map(|e| Circle::new((e.phi_over_2pi, e.twist), 4, BLACK.filled())),
+        )
+        .map_err(err)?;
+    let labels: Vec<Label> = labelled
+        .iter()
+        .map(|e| Label {
+            text: e.label.clone(),
+            at: chart.backend_coord(&(e.phi_over_2pi, e.twist)),
+        })
+        .collect();
+    let (px, py) = chart.plotting_area().get_pixel_range();
+    place_labels(
+        &root,
+        &labels,
+        (px.start, py.start, px.end, py.end),
+        &("sans-serif", 14).into_font().color(&BLACK),
+    )?;
+    // lowest ω² on a symmetric log scale: its sign changes show
     let om: Vec<f64> = eqs
         .iter()
         .filter_map(|e| e.omega_squared)
         .filter(|v| finite(*v))
         .collect();
-    let (o0, o1) = bounds(&om);
+    let log = SymLog::for_values(&om);
+    let (o0, o1) = bounds(&om.iter().map(|v| log.to(*v)).collect::<Vec<_>>());
     let mut c2 = ChartBuilder::on(&mid)
         .margin(8)
-        .x_label_area_size(25)
-        .y_label_area_size(50)
+        .margin_right(18)
+        .x_label_area_size(26)
+        .y_label_area_size(y_area)
         .build_cartesian_2d(x0..x1, o0..o1)
         .map_err(err)?;
+    // the ticks drawn here: plotters would place them evenly in the
+    // transformed value
     c2.configure_mesh()
-        .y_desc("lowest ω²")
+        .y_desc(if log.linear {
+            "lowest ω²"
+        } else {
+            "lowest ω² (symlog)"
+        })
+        .x_label_formatter(&|v| tick_text(*v))
+        .y_labels(0)
+        .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(err)?;
-    c2.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], BLACK.mix(0.4)))
+    let tick_font =
+        ("sans-serif", 12)
+            .into_font()
+            .color(&BLACK)
+            .pos(plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Right,
+                plotters::style::text_anchor::VPos::Center,
+            ));
+    let mut drawn: Vec<i32> = Vec::new();
+    for tick in log.ticks(o0, o1) {
+        // nearest zero first; a tick too close to one drawn is left out
+        let (x, y) = c2.backend_coord(&(x0, tick));
+        if drawn.iter().any(|d| (d - y).abs() < 14) {
+            continue;
+        }
+        drawn.push(y);
+        c2.draw_series(LineSeries::new(
+            [(x0, tick), (x1, tick)],
+            BLACK.mix(0.12).stroke_width(1),
+        ))
         .map_err(err)?;
-    for leg in legs(eqs) {
-        let pts: Vec<(f64, f64)> = leg
-            .iter()
-            .filter_map(|e| e.omega_squared.map(|w| (e.phi_over_2pi, w)))
-            .collect();
-        c2.draw_series(LineSeries::new(pts, RGBColor(80, 80, 80).stroke_width(2)))
+        root.draw(&PathElement::new(vec![(x - 5, y), (x, y)], BLACK))
             .map_err(err)?;
+        root.draw(&Text::new(
+            tick_text(log.from(tick)),
+            (x - 8, y),
+            tick_font.clone(),
+        ))
+        .map_err(err)?;
+    }
+    if o0 < 0.0 && o1 > 0.0 {
+        c2.draw_series(LineSeries::new(
+            [(x0, 0.0), (x1, 0.0)],
+            BLACK.mix(0.7).stroke_width(1),
+        ))
+        .map_err(err)?;
+    }
+    for leg in legs(eqs) {
+        // coloured by stability, as the diagram above
+        for w in leg.windows(2) {
+            let (Some(a), Some(b)) = (w[0].omega_squared, w[1].omega_squared) else {
+                continue;
+            };
+            let colour = if a > 0.0 && b > 0.0 {
+                RGBColor(60, 60, 60)
+            } else {
+                colour_of(Class::Unstable)
+            };
+            c2.draw_series(LineSeries::new(
+                [
+                    (w[0].phi_over_2pi, log.to(a)),
+                    (w[1].phi_over_2pi, log.to(b)),
+                ],
+                colour.stroke_width(2),
+            ))
+            .map_err(err)?;
+        }
     }
     let sd: Vec<f64> = eqs
         .iter()
@@ -239,13 +589,17 @@ where
     let (s0, s1) = bounds(&sd);
     let mut c3 = ChartBuilder::on(&low)
         .margin(8)
-        .x_label_area_size(30)
-        .y_label_area_size(50)
+        .margin_right(18)
+        .x_label_area_size(34)
+        .y_label_area_size(y_area)
         .build_cartesian_2d(x0..x1, s0.min(0.0)..s1)
         .map_err(err)?;
     c3.configure_mesh()
         .x_desc("φ/2π")
         .y_desc("min self-distance")
+        .x_label_formatter(&|v| tick_text(*v))
+        .y_label_formatter(&|v| tick_text(*v))
+        .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(err)?;
     for leg in legs(eqs) {
@@ -259,6 +613,68 @@ where
     }
     root.present().map_err(err)?;
     Ok(())
+}
+
+/// When the branches lie at several z* (or δ), one each: their values in
+/// the order of their turning points (least φ), e.g. "z* = 0.115, 0.15, 0.18
+/// (branches from left to right)"; empty otherwise.
+fn branch_names(eqs: &[PlotPoint]) -> String {
+    let distinct = |f: fn(&PlotPoint) -> f64| {
+        let mut v: Vec<f64> = eqs.iter().map(f).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        v.len()
+    };
+    let (name, of): (&str, fn(&PlotPoint) -> f64) = if distinct(|e| e.z_star) > 1 {
+        ("z*", |e| e.z_star)
+    } else if distinct(|e| e.delta) > 1 {
+        ("δ", |e| e.delta)
+    } else {
+        return String::new();
+    };
+    let mut branches: Vec<usize> = eqs.iter().map(|e| e.branch).collect();
+    branches.sort_unstable();
+    branches.dedup();
+    let mut turns: Vec<(f64, f64, f64)> = branches
+        .into_iter()
+        .filter_map(|b| {
+            let on: Vec<&PlotPoint> = eqs.iter().filter(|e| e.branch == b).collect();
+            let first = on.first()?;
+            // a branch held at one value of the second parameter
+            if on.iter().any(|e| (of(e) - of(first)).abs() > 1e-9) {
+                return None;
+            }
+            let turn = on
+                .iter()
+                .min_by(|a, b| a.phi_over_2pi.total_cmp(&b.phi_over_2pi))?;
+            let end = on
+                .iter()
+                .max_by(|a, b| a.phi_over_2pi.total_cmp(&b.phi_over_2pi))?;
+            Some((turn.phi_over_2pi, of(first), end.twist))
+        })
+        .collect();
+    turns.dedup_by(|a, b| (a.1 - b.1).abs() < 1e-9);
+    if turns.len() < 2 {
+        return String::new();
+    }
+    // by their turning points when they turn at distinct φ (Figure 6), else
+    // (branches cut at one φ, Figure 8) by their height at the right end
+    let folds: Vec<f64> = turns.iter().map(|t| t.0).collect();
+    let (f0, f1) = (
+        folds.iter().copied().fold(f64::INFINITY, f64::min),
+        folds.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    );
+    let spread = f1 - f0;
+    let (x0, x1) = bounds(&eqs.iter().map(|e| e.phi_over_2pi).collect::<Vec<_>>());
+    let order = if spread > 0.02 * (x1 - x0) {
+        turns.sort_by(|a, b| a.0.total_cmp(&b.0));
+        "branches from left to right"
+    } else {
+        turns.sort_by(|a, b| b.2.total_cmp(&a.2));
+        "branches from top to bottom at the right"
+    };
+    let values: Vec<String> = turns.iter().map(|t| tick_text(t.1)).collect();
+    format!("{name} = {} ({order})", values.join(", "))
 }
 
 fn bounds(v: &[f64]) -> (f64, f64) {
@@ -365,20 +781,31 @@ where
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     root.fill(&WHITE).map_err(err)?;
+    let mut present: Vec<RGBColor> = Vec::new();
+    for c in map.grid.iter().flatten().filter(|c| **c != Class::None) {
+        if !present.contains(&colour_of(*c)) {
+            present.push(colour_of(*c));
+        }
+    }
+    let (head, body) = root.split_vertically(56);
+    draw_head(&head, &format!("{}: good knots", map.scene), &present)?;
     let (x0, x1) = bounds(&map.grid_along);
     let values: Vec<f64> = map.lines.iter().map(|l| l.value).collect();
     let (y0, y1) = bounds(&values);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{}: good knots", map.scene), ("sans-serif", 18))
+    let mut chart = ChartBuilder::on(&body)
         .margin(10)
+        .margin_right(18)
         .x_label_area_size(35)
-        .y_label_area_size(55)
+        .y_label_area_size(62)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
     chart
         .configure_mesh()
         .x_desc(map.along.symbol())
         .y_desc(map.parameter.symbol())
+        .x_label_formatter(&|v| tick_text(*v))
+        .y_label_formatter(&|v| tick_text(*v))
+        .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(err)?;
     for (row, l) in map.grid.iter().zip(&map.lines) {
@@ -392,22 +819,144 @@ where
                 .map_err(err)?;
         }
     }
+    let mut labels = Vec::new();
     for (name, pts) in &map.boundaries {
         // in order along the curve (traced walks fold; grid chains go by line)
         let pts: Vec<(f64, f64)> = pts.iter().map(|p| (p[1], p[0])).collect();
         chart
             .draw_series(LineSeries::new(pts.clone(), BLACK.stroke_width(2)))
             .map_err(err)?;
-        if let Some(&(x, y)) = pts.get(pts.len() / 2) {
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    name.clone(),
-                    (x, y),
-                    ("sans-serif", 16).into_font().color(&BLACK),
-                )))
-                .map_err(err)?;
+        if let Some(at) = pts.get(pts.len() / 2) {
+            labels.push(Label {
+                text: name.clone(),
+                at: chart.backend_coord(at),
+            });
         }
     }
+    // the curves' names (S, X, W1, W2) beside them, inside the frame
+    let (px, py) = chart.plotting_area().get_pixel_range();
+    place_labels(
+        &root,
+        &labels,
+        (px.start, py.start, px.end, py.end),
+        &("sans-serif", 16).into_font().color(&BLACK),
+    )?;
     root.present().map_err(err)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_symmetric_log_keeps_signs_and_inverts() {
+        let log = SymLog::for_values(&[-3500.0, 2.0, 900.0]);
+        // three decades below the largest value
+        assert_eq!(log.c, 1.0);
+        for v in [-3500.0, -1.0, -1e-3, 0.0, 1e-3, 0.5, 2.0, 900.0] {
+            let t = log.to(v);
+            assert!(t.signum() * v.signum() >= 0.0, "{v}: sign kept");
+            assert!((log.from(t) - v).abs() <= 1e-12 * v.abs().max(1.0), "{v}");
+        }
+        assert!(log.to(-1.0) < log.to(-1e-3) && log.to(1e-3) < log.to(1.0));
+        // the ticks: 0 first, then ±{1, 2, 5}·c·10^k outwards, inside the
+        // range only
+        let ticks = log.ticks(log.to(-5000.0), log.to(2000.0));
+        assert_eq!(ticks[0], 0.0);
+        let values: Vec<f64> = ticks.iter().map(|t| log.from(*t).round()).collect();
+        for v in [1.0, -1.0, 10.0, -20.0, 500.0, 1000.0, -2000.0] {
+            assert!(values.contains(&v), "{v} in {values:?}");
+        }
+        assert!(!values.contains(&10000.0) && !values.contains(&5000.0));
+        // one sign within a decade: linear, round ticks, no zero
+        let log = SymLog::for_values(&[394.6, 787.8]);
+        assert!(log.linear && log.to(500.0) == 500.0);
+        let ticks = log.ticks(375.0, 808.0);
+        assert_eq!(ticks, [400.0, 500.0, 600.0, 700.0, 800.0]);
+    }
+
+    #[test]
+    fn tick_labels_are_brief() {
+        for (v, text) in [
+            (-6e-17, "0"),
+            (0.0, "0"),
+            (0.005, "0.005"),
+            (-0.15, "-0.15"),
+            (0.1150, "0.115"),
+            (999.9999999, "1000"),
+            (-3500.0, "-3500"),
+            (12000.0, "1e4"),
+        ] {
+            assert_eq!(tick_text(v), text, "{v}");
+        }
+    }
+
+    /// The labels an SVG holds: their text and top-left corners.
+    fn texts(svg: &str) -> Vec<(String, i32, i32)> {
+        svg.split("<text")
+            .skip(1)
+            .map(|t| {
+                let attr = |name: &str| -> i32 {
+                    let at = t.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+                    t[at..].split('"').next().unwrap().parse::<f64>().unwrap() as i32
+                };
+                let body = t.split('>').nth(1).unwrap().split('<').next().unwrap();
+                (body.trim().to_string(), attr("x"), attr("y"))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn labels_stay_inside_the_frame_and_clear_of_each_other() {
+        let frame = (20, 20, 380, 280);
+        // crowded pairs, one at each corner of the frame, and one event
+        // located twice at one point (named once)
+        let points = [
+            ("F1", (21, 150)),
+            ("S", (24, 154)),
+            ("W1", (379, 21)),
+            ("W2", (376, 25)),
+            ("X", (200, 279)),
+            ("X2", (203, 276)),
+            ("Q", (200, 150)),
+            ("Q", (201, 151)),
+        ];
+        let labels: Vec<Label> = points
+            .iter()
+            .map(|(t, at)| Label {
+                text: t.to_string(),
+                at: *at,
+            })
+            .collect();
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (400, 300)).into_drawing_area();
+            let font = ("sans-serif", 14).into_font().color(&BLACK);
+            place_labels(&root, &labels, frame, &font).unwrap();
+            root.present().unwrap();
+        }
+        let placed = texts(&svg);
+        assert_eq!(placed.len(), 7, "{placed:?}");
+        assert_eq!(placed.iter().filter(|p| p.0 == "Q").count(), 1);
+        // a label's box: its anchor is the top-left corner; glyphs about
+        // 0.6 of the size wide when no font is at hand
+        let boxes: Vec<(i32, i32, i32, i32)> = placed
+            .iter()
+            .map(|(t, x, y)| (*x, *y, x + 9 * t.chars().count() as i32, y + 14))
+            .collect();
+        for (b, p) in boxes.iter().zip(&placed) {
+            assert!(
+                b.0 >= frame.0 && b.1 >= frame.1 && b.2 <= frame.2 + 2 && b.3 <= frame.3 + 2,
+                "{p:?} outside the frame"
+            );
+        }
+        for i in 0..boxes.len() {
+            for j in 0..i {
+                let (a, b) = (boxes[i], boxes[j]);
+                let overlap = a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
+                assert!(!overlap, "{:?} over {:?}", placed[i], placed[j]);
+            }
+        }
+    }
 }

@@ -129,13 +129,18 @@ pub fn print_equilibrium(
     )?;
     writeln!(
         out,
-        "  {} ({} negative eigenvalues); lowest ω² = {:?}",
+        "  {} ({} negative eigenvalues); lowest ω² = {}",
         if e.stable { "stable" } else { "UNSTABLE" },
         e.negative_eigenvalues,
-        e.omega_squared
-            .iter()
-            .map(|v| format!("{v:.4}"))
-            .collect::<Vec<_>>()
+        if e.omega_squared.is_empty() {
+            "not computed".to_string()
+        } else {
+            e.omega_squared
+                .iter()
+                .map(|v| format!("{v:.4}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
     )?;
     writeln!(
         out,

@@ -161,8 +161,8 @@ pub fn compare_with_continuation(input: &AutoInput) -> Result<EventsComparison> 
         return Ok(compare(input, None, &[]));
     };
     let scene = Scene::load(path).context("the AUTO mapping's continuation scene")?;
-    let events = run_scene(&scene, None, &mut |_| Ok(()))
-        .with_context(|| format!("running {}", path.display()))?;
+    let events =
+        run_scene(&scene, None, &mut ()).with_context(|| format!("running {}", path.display()))?;
     Ok(compare(input, Some(path.display().to_string()), &events))
 }
 

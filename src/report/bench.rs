@@ -188,7 +188,7 @@ fn branch_workloads(d: &Scene, fig3: &Scene) -> Result<Vec<Workload>> {
     let mut inertia_only = main_branch.clone();
     inertia_only.stability.eigenvalues = 0;
     workloads.push(timed("figure_3_branch", 200, || {
-        crate::study::run::run_scene(&inertia_only, Some(200), &mut |_| Ok(()))
+        crate::study::run::run_scene(&inertia_only, Some(200), &mut ())
             .map(|_| ())
             .map_err(Into::into)
     })?);
@@ -196,7 +196,7 @@ fn branch_workloads(d: &Scene, fig3: &Scene) -> Result<Vec<Workload>> {
     // step (the step count does not change with N)
     for n in BRANCH_SEGMENTS {
         workloads.push(timed(BRANCH_WITH_EIGENVALUES, n, || {
-            crate::study::run::run_scene(&main_branch, Some(n), &mut |_| Ok(()))
+            crate::study::run::run_scene(&main_branch, Some(n), &mut ())
                 .map(|_| ())
                 .map_err(Into::into)
         })?);
@@ -269,9 +269,11 @@ fn figure_3_values(events: &[crate::analysis::event::Event]) -> Result<Vec<f64>>
 fn event_workloads(scenes: &Path) -> Result<Vec<Workload>> {
     let polished = Scene::load(&scenes.join("fig3_polished.toml"))?;
     let run = |scene: &Scene, n: usize| -> Result<Vec<crate::analysis::event::Event>> {
-        Ok(crate::study::run::run_scene(scene, Some(n), &mut |_| {
-            Ok(())
-        })?)
+        Ok(crate::study::run::run_scene(
+            scene,
+            Some(n),
+            &mut crate::study::observer::equilibria(|_| Ok(())),
+        )?)
     };
     let reference = figure_3_values(&run(&polished, 120)?)?;
     let mut discrete = polished.clone();

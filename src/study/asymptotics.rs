@@ -50,7 +50,7 @@ fn strip_scene(
 }
 
 fn crossings(scene: &Scene) -> Result<Vec<Event>> {
-    let events = run_scene(scene, None, &mut |_| Ok(()))?;
+    let events = run_scene(scene, None, &mut ())?;
     Ok(events
         .into_iter()
         .filter(|e| e.kind == EventKind::Crossing)

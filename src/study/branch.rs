@@ -14,6 +14,7 @@ use crate::solve::continuation::{
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
 use crate::study::error::{Context, Result};
+use crate::study::observer::Observer;
 
 /// The discrete values of the [`Vanishing`] quantities watched along a
 /// branch: `wall` the wall gap, `knot` and `link` the strand gap (they jump
@@ -74,9 +75,6 @@ fn knot_label(alexander: &[i64]) -> String {
     }
 }
 
-/// What the caller gets for every accepted point.
-pub type Observer<'o> = dyn FnMut(Equilibrium) -> Result<()> + 'o;
-
 /// Options of a branch run.
 #[derive(Clone, Debug)]
 pub struct BranchOptions {
@@ -100,7 +98,7 @@ pub struct BranchOptions {
 pub struct BranchRun<'a, 'r> {
     tracer: Tracer<'a>,
     options: BranchOptions,
-    observer: &'r mut Observer<'r>,
+    observer: &'r mut dyn Observer,
     /// Located events, in the order found.
     pub events: Vec<Event>,
     /// The equilibrium at each located event (`events[k]` at `located[k]`).
@@ -121,7 +119,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
     pub fn new(
         newton: &'a mut Minimizer,
         options: BranchOptions,
-        observer: &'r mut Observer<'r>,
+        observer: &'r mut dyn Observer,
         first_branch: usize,
     ) -> Self {
         BranchRun {
@@ -172,6 +170,20 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         v >= self.options.range[0] && v <= self.options.range[1]
     }
 
+    /// Hand the events from `found` on to the observer, labelled as the
+    /// events so far label them (provisionally: see [`Observer::event`]).
+    fn report_events(&mut self, found: usize) -> Result<()> {
+        if found == self.events.len() {
+            return Ok(());
+        }
+        let mut labelled = self.events.clone();
+        crate::analysis::event::label_events(&mut labelled);
+        for e in &labelled[found..] {
+            self.observer.event(e)?;
+        }
+        Ok(())
+    }
+
     /// Number of the next branch to be traced.
     pub fn next_branch(&self) -> usize {
         self.next_branch
@@ -200,12 +212,16 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                     match self.tracer.switch(&bp, &null, sign, sigma) {
                         Ok(p) if self.in_range(&p) => self.trace(p, b, 0, true)?,
                         Ok(_) => {}
-                        Err(e) => self.record(
-                            EventKind::End,
-                            &bp,
-                            b,
-                            format!("branch switch failed: {e}"),
-                        ),
+                        Err(e) => {
+                            let found = self.events.len();
+                            self.record(
+                                EventKind::End,
+                                &bp,
+                                b,
+                                format!("branch switch failed: {e}"),
+                            );
+                            self.report_events(found)?;
+                        }
                     }
                 }
             }
@@ -218,7 +234,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         let eq = self.measure(&start, branch, leg)?;
         let mut wa = TestValues::of(&eq, &self.options.measure);
         if emit_start {
-            (self.observer)(eq)?;
+            self.observer.equilibrium(eq)?;
         }
         let mut a = start;
         let mut step = settings.step_control();
@@ -227,12 +243,14 @@ impl<'a, 'r> BranchRun<'a, 'r> {
                 break;
             }
             let Some((b, ds)) = self.tracer.advance(&a, &mut step) else {
+                let found = self.events.len();
                 self.record(
                     EventKind::End,
                     &a,
                     branch,
                     "step below min_step: branch lost".into(),
                 );
+                self.report_events(found)?;
                 break;
             };
             let eq = self.measure(&b, branch, leg)?;
@@ -241,7 +259,8 @@ impl<'a, 'r> BranchRun<'a, 'r> {
             if self.options.locate_events {
                 self.locate_events(&a, &b, &wa, &wb, ds, branch)?;
             }
-            (self.observer)(eq)?;
+            self.report_events(found)?;
+            self.observer.equilibrium(eq)?;
             if self.events[found..]
                 .iter()
                 .any(|e| self.options.stop_at.contains(&e.kind))

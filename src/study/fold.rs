@@ -100,10 +100,10 @@ pub fn fold_near(
     };
     let settings_tolerance = options.settings.tolerance;
     let mut reached = 0usize;
-    let mut ignore = |_: Equilibrium| {
+    let mut ignore = crate::study::observer::equilibria(|_: Equilibrium| {
         reached += 1;
         Ok(())
-    };
+    });
     let mut run = BranchRun::new(&mut newton, options, &mut ignore, 0);
     run.follow(state, &[1.0, -1.0])
         .context("following the discrete branch to its fold")?;

@@ -11,8 +11,8 @@ use crate::model::rod::{Clamps, RodState};
 use crate::scene::LoadingSpec;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::{SolveError, SolveReport, SolverSettings};
-use crate::study::branch::Observer;
 use crate::study::error::{Context, Result, StudyError, fail};
+use crate::study::observer::Observer;
 
 /// A step is a jump when the minimiser lands farther than this (rod lengths)
 /// from the first-order prediction (and than half the predicted move).
@@ -281,11 +281,11 @@ pub fn run_loading(
     path: &[LoadingSpec],
     settings: &SolverSettings,
     measure: &Measure,
-    observer: &mut Observer<'_>,
+    observer: &mut dyn Observer,
 ) -> Result<Vec<Event>> {
     let report = minimize_to_stable(newton, &mut state, settings)?;
     let mut eq = analyse(newton, &state, &report, measure)?;
-    observer(eq.clone())?;
+    observer.equilibrium(eq.clone())?;
     let mut hand = Hand {
         newton,
         settings,
@@ -318,6 +318,7 @@ pub fn run_loading(
                 leg,
                 k,
             };
+            let found = hand.events.len();
             let (step, next) = hand.advance(&at)?;
             if eq.walled != next.walled && !step.jumped {
                 hand.locate_wall(&at)?;
@@ -325,7 +326,14 @@ pub fn run_loading(
             if !eq.contacts.is_empty() && next.contacts.is_empty() {
                 hand.locate_contact_loss(&at)?;
             }
-            observer(next.clone())?;
+            // the path's events as located (labels provisional), then the
+            // equilibrium past them
+            let mut labelled = hand.events.clone();
+            crate::analysis::event::label_events(&mut labelled);
+            for e in &labelled[found..] {
+                observer.event(e)?;
+            }
+            observer.equilibrium(next.clone())?;
             state = step.state;
             eq = next;
         }

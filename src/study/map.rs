@@ -374,10 +374,10 @@ fn compute_line(
         stop_at: Vec::new(),
     };
     let mut eqs = Vec::new();
-    let mut obs = |e: Equilibrium| {
+    let mut obs = crate::study::observer::equilibria(|e: Equilibrium| {
         eqs.push(e);
         Ok(())
-    };
+    });
     let mut run = BranchRun::new(&mut newton, options, &mut obs, 0);
     run.follow(state, &[1.0, -1.0])?;
     let events = std::mem::take(&mut run.events);

@@ -9,6 +9,7 @@ pub mod error;
 pub mod fold;
 pub mod loading;
 pub mod map;
+pub mod observer;
 pub mod polish;
 pub mod run;
 pub mod start;

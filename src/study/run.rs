@@ -7,9 +7,10 @@ use crate::model::rod::{Parameter, RodState};
 use crate::scene::{Direction, Scene};
 use crate::solve::continuation::{ContinuationSettings, Tracer};
 use crate::solve::minimizer::Minimizer;
-use crate::study::branch::{BranchOptions, BranchRun, Observer};
+use crate::study::branch::{BranchOptions, BranchRun};
 use crate::study::error::{Context, Result, fail};
 use crate::study::loading::run_loading;
+use crate::study::observer::Observer;
 use crate::study::start::starting_equilibrium;
 
 /// Move an equilibrium to `parameter = target` by continuation in that
@@ -64,12 +65,13 @@ pub fn continue_to(
     )
 }
 
-/// Run a scene at N segments (the scene's if None): every equilibrium goes to
-/// `observer` as soon as it is computed; returns the labelled events.
+/// Run a scene at N segments (the scene's if None): every equilibrium and
+/// event goes to `observer` as soon as it is computed; returns the labelled
+/// events.
 pub fn run_scene(
     scene: &Scene,
     segments: Option<usize>,
-    observer: &mut Observer<'_>,
+    observer: &mut dyn Observer,
 ) -> Result<Vec<Event>> {
     let (mut newton, mut state, report) = starting_equilibrium(scene, segments)?;
     let measure = scene.measure();
@@ -86,7 +88,7 @@ pub fn run_scene(
         return Ok(events);
     }
     let Some(spec) = &scene.continuation else {
-        observer(analyse(&mut newton, &state, &report, &measure)?)?;
+        observer.equilibrium(analyse(&mut newton, &state, &report, &measure)?)?;
         return Ok(vec![]);
     };
     if !spec.parameter.value(&state.clamps).is_finite() {

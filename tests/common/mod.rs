@@ -66,10 +66,14 @@ pub fn scene_at(file: &str, segments: usize) -> Scene {
 /// Run a scene; its equilibria and events.
 pub fn run(scene: &Scene) -> (Vec<Equilibrium>, Vec<Event>) {
     let mut eqs = Vec::new();
-    let events = knotrod::study::run::run_scene(scene, None, &mut |e| {
-        eqs.push(e);
-        Ok(())
-    })
+    let events = knotrod::study::run::run_scene(
+        scene,
+        None,
+        &mut knotrod::study::observer::equilibria(|e| {
+            eqs.push(e);
+            Ok(())
+        }),
+    )
     .unwrap();
     (eqs, events)
 }

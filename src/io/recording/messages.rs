@@ -145,6 +145,8 @@ impl From<&Scalars> for PlotPoint {
             min_self_distance: e.min_self_distance,
             branch: e.branch,
             leg: e.leg,
+            z_star: e.z_star,
+            delta: e.delta,
         }
     }
 }

@@ -255,7 +255,7 @@ fn k3_branch_table() -> Result<String> {
              [stability]\neigenvalues = 2\n"
         );
         let scene = Scene::parse(&text)?;
-        let events = run_scene(&scene, None, &mut |_| Ok(()))?;
+        let events = run_scene(&scene, None, &mut ())?;
         let k3 = events
             .iter()
             .filter(|e| e.kind == crate::analysis::event::EventKind::Stability)
@@ -293,10 +293,14 @@ fn heavy_knot_table(scenes: &Path) -> Result<String> {
                 );
             let scene = Scene::parse(&t)?;
             let mut last = None;
-            run_scene(&scene, None, &mut |e| {
-                last = Some(e);
-                Ok(())
-            })?;
+            run_scene(
+                &scene,
+                None,
+                &mut crate::study::observer::equilibria(|e| {
+                    last = Some(e);
+                    Ok(())
+                }),
+            )?;
             let last = last.ok_or_else(|| failed("heavy knot: no equilibrium"))?;
             Ok((n, last, scene))
         })
@@ -343,10 +347,14 @@ fn strip_weight_table(scenes: &Path) -> Result<String> {
         scene.model.segments
     )?;
     let mut eqs = Vec::new();
-    let events = run_scene(&scene, None, &mut |e| {
-        eqs.push(e);
-        Ok(())
-    })?;
+    let events = run_scene(
+        &scene,
+        None,
+        &mut crate::study::observer::equilibria(|e| {
+            eqs.push(e);
+            Ok(())
+        }),
+    )?;
     writeln!(
         s,
         "| w L³/B | n(0) | Tw | Lk | walled | stable | knot | good | self-distance |"

@@ -13,10 +13,14 @@ pub(super) fn run_text(
 )> {
     let scene = Scene::parse(text)?;
     let mut eqs = Vec::new();
-    let events = crate::study::run::run_scene(&scene, None, &mut |e| {
-        eqs.push(e);
-        Ok(())
-    })?;
+    let events = crate::study::run::run_scene(
+        &scene,
+        None,
+        &mut crate::study::observer::equilibria(|e| {
+            eqs.push(e);
+            Ok(())
+        }),
+    )?;
     Ok((eqs, events))
 }
 
