@@ -19,6 +19,7 @@ mod free_ends;
 mod fuzz;
 mod general_rods;
 mod knots;
+mod live;
 mod map_general;
 mod maps;
 mod model_parameters;

@@ -44,6 +44,10 @@ pub enum Command {
         /// Do not record.
         #[arg(long, conflicts_with = "record")]
         no_record: bool,
+        /// Serve the run live to the Foxglove app (WebSocket) at HOST:PORT
+        /// (default 127.0.0.1:8765; port 0: any free port, printed).
+        #[arg(long, num_args = 0..=1, default_missing_value = crate::io::live::DEFAULT_ADDRESS)]
+        live: Option<String>,
         /// Run even when the predicted memory or CPU time exceeds `[budget]`.
         #[arg(long)]
         allow_large: bool,
@@ -188,12 +192,14 @@ pub fn main_with(cli: Cli) -> Result<()> {
             segments,
             record,
             no_record,
+            live,
             allow_large,
         } => run::run(
             &scene,
             json,
             segments,
             if no_record { None } else { Some(record) },
+            live.as_deref(),
             allow_large,
         ),
         Command::Info { recording } => Ok(crate::io::export::info(

@@ -5,6 +5,7 @@
 use super::progress::Progress;
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
+use crate::io::live::Live;
 use crate::io::output::{Output, OutputKind, output_kind};
 use crate::io::plot::{PlotPoint, bifurcation_diagram};
 use crate::io::recording::Recorder;
@@ -30,6 +31,7 @@ pub fn run(
     json: Option<PathBuf>,
     segments: Option<usize>,
     record: Option<Option<PathBuf>>,
+    live: Option<&str>,
     allow_large: bool,
 ) -> Result<()> {
     let scene = Scene::load(path)?;
@@ -51,12 +53,25 @@ pub fn run(
         json.as_deref().is_some_and(dash) || matches!(&record, Some(Some(p)) if dash(p));
     let mut summary = Summary::new(&scene, &model);
     let mut outputs = Outputs::open(path, &scene, &model, json.as_deref(), record)?;
+    let mut live = match live {
+        Some(address) => {
+            let l = Live::start(address, &model, scene.model.rod_diameter)?;
+            let host = address.rsplit_once(':').map_or(address, |(h, _)| h);
+            eprintln!(
+                "live view at ws://{host}:{} (Foxglove: Open connection, Foxglove WebSocket)",
+                l.port()
+            );
+            Some(l)
+        }
+        None => None,
+    };
     let progress = Progress::spinner("equilibria");
     let mut watch = Watch {
         outputs: &mut outputs,
         progress: &progress,
         summary: &mut summary,
         events: Vec::new(),
+        live: live.as_mut(),
     };
     let result = run_scene(&scene, segments, &mut watch);
     let mut located = watch.events;
@@ -90,6 +105,11 @@ pub fn run(
     // the recording, the stream and the summary are finalised whatever
     // happened, with what was computed
     let summary_out = outputs.finish(&summary.events, &mut out)?;
+    if let Some(l) = live {
+        l.final_events(&summary.events)?;
+        // what was published reaches the clients before the server goes
+        l.stop();
+    }
     report(&scene, &summary, json.as_deref(), &mut out)?;
     if let Some(file) = summary_out {
         let path = file.path().to_path_buf();
@@ -109,6 +129,8 @@ struct Watch<'a> {
     summary: &'a mut Summary,
     /// The events as located: a run stopped early keeps those it passed.
     events: Vec<Event>,
+    /// The live view, if serving.
+    live: Option<&'a mut Live>,
 }
 
 impl Observer for Watch<'_> {
@@ -116,6 +138,10 @@ impl Observer for Watch<'_> {
         self.outputs
             .equilibrium(&eq)
             .map_err(|e| StudyError::Observer(e.into()))?;
+        if let Some(live) = self.live.as_mut() {
+            live.equilibrium(&eq)
+                .map_err(|e| StudyError::Observer(e.into()))?;
+        }
         self.progress.item(describe(&eq));
         self.summary.equilibria.push(eq);
         if INTERRUPTED.load(Ordering::SeqCst) {
@@ -127,6 +153,9 @@ impl Observer for Watch<'_> {
     }
 
     fn event(&mut self, e: &Event) -> Result<(), StudyError> {
+        if let Some(live) = self.live.as_mut() {
+            live.event(e).map_err(|e| StudyError::Observer(e.into()))?;
+        }
         self.events.push(e.clone());
         Ok(())
     }

@@ -10,6 +10,7 @@ pub mod error;
 pub mod export;
 pub mod fuzz;
 pub mod json;
+pub mod live;
 pub mod map_files;
 pub mod output;
 pub mod plot;

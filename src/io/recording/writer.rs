@@ -57,36 +57,51 @@ fn mcap_error(step: &'static str, path: &Path) -> impl FnOnce(mcap::McapError) -
 /// The MCAP writer of a recording file.
 type Mcap = mcap::Writer<BufWriter<Output>>;
 
+/// One channel of a recording (and of the live view): its topic, its
+/// schema and the encoding of its messages.
+pub(crate) struct ChannelSpec {
+    /// Topic.
+    pub topic: &'static str,
+    /// The schema (name, encoding, data).
+    pub schema: foxglove::Schema,
+    /// "protobuf" or "json".
+    pub message_encoding: &'static str,
+}
+
+/// The five channels: scene, transform, scalars, state, events.
+pub(crate) fn channel_specs() -> [ChannelSpec; 5] {
+    let protobuf = |topic, schema: Option<foxglove::Schema>| ChannelSpec {
+        topic,
+        schema: schema.expect("Foxglove's well-known messages have schemas"),
+        message_encoding: "protobuf",
+    };
+    let json = |topic, name: &str, data: &'static str| ChannelSpec {
+        topic,
+        schema: foxglove::Schema::new(name, "jsonschema", data.as_bytes()),
+        message_encoding: "json",
+    };
+    [
+        protobuf(SCENE_TOPIC, SceneUpdate::get_schema()),
+        protobuf(TF_TOPIC, FrameTransform::get_schema()),
+        json(SCALARS_TOPIC, "knotrod.Scalars", SCALARS_SCHEMA),
+        json(STATE_TOPIC, "knotrod.RodState", STATE_SCHEMA),
+        json(EVENTS_TOPIC, "knotrod.Event", EVENT_SCHEMA),
+    ]
+}
+
 /// The five channels, in the order of [`Recorder`]'s `channels`.
 fn add_channels(writer: &mut Mcap, path: &Path) -> Result<[u16; 5]> {
-    let mut channel = |topic: &str,
-                       schema: Option<foxglove::Schema>,
-                       json_title: &str,
-                       json: &str|
-     -> Result<u16> {
-        let (name, encoding, data, msg_enc) = match schema {
-            Some(s) => (s.name, s.encoding, s.data.into_owned(), "protobuf"),
-            None => (
-                json_title.to_string(),
-                "jsonschema".to_string(),
-                json.as_bytes().to_vec(),
-                "json",
-            ),
-        };
+    let mut ids = [0; 5];
+    for (id, spec) in ids.iter_mut().zip(channel_specs()) {
+        let s = &spec.schema;
         let sid = writer
-            .add_schema(&name, &encoding, &data)
+            .add_schema(&s.name, &s.encoding, &s.data)
             .map_err(mcap_error("adding a schema", path))?;
-        writer
-            .add_channel(sid, topic, msg_enc, &BTreeMap::new())
-            .map_err(mcap_error("adding a channel", path))
-    };
-    Ok([
-        channel(SCENE_TOPIC, SceneUpdate::get_schema(), "", "")?,
-        channel(TF_TOPIC, FrameTransform::get_schema(), "", "")?,
-        channel(SCALARS_TOPIC, None, "knotrod.Scalars", SCALARS_SCHEMA)?,
-        channel(STATE_TOPIC, None, "knotrod.RodState", STATE_SCHEMA)?,
-        channel(EVENTS_TOPIC, None, "knotrod.Event", EVENT_SCHEMA)?,
-    ])
+        *id = writer
+            .add_channel(sid, spec.topic, spec.message_encoding, &BTreeMap::new())
+            .map_err(mcap_error("adding a channel", path))?;
+    }
+    Ok(ids)
 }
 
 /// The metadata: the scene text, the versions and the model.
@@ -115,6 +130,45 @@ fn write_metadata(
             metadata: meta,
         })
         .map_err(mcap_error("writing the metadata", path))
+}
+
+/// The messages of state `index` on the first four channels (scene,
+/// transform, scalars, state), as a recording and the live view send them
+/// (`path` names the recording in errors).
+pub(crate) fn state_messages(
+    index: u64,
+    e: &Equilibrium,
+    model: &RodModel,
+    rod_diameter: f64,
+    path: &Path,
+) -> Result<[Vec<u8>; 4]> {
+    let stamp = Some(Timestamp::new(index as u32, 0));
+    let scene = encode(&scene_update(e, rod_diameter, stamp), path)?;
+    let tf = FrameTransform {
+        timestamp: stamp,
+        parent_frame_id: "world".into(),
+        child_frame_id: "rod".into(),
+        translation: Some(FgVector3 {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+        }),
+        rotation: Some(Quaternion {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            w: 1.0,
+        }),
+    };
+    let scalars = serde_json::to_vec(&Scalars::of(index, e))
+        .map_err(IoError::json("encoding the scalars", path))?;
+    let state = StateMessage {
+        index,
+        model: model.clone(),
+        state: e.state.clone(),
+    };
+    let state = serde_json::to_vec(&state).map_err(IoError::json("encoding the state", path))?;
+    Ok([scene, encode(&tf, path)?, scalars, state])
 }
 
 impl Recorder {
@@ -216,38 +270,10 @@ impl Recorder {
     pub fn record(&mut self, e: &Equilibrium) -> Result<()> {
         let index = self.count;
         let t = index * 1_000_000_000;
-        let stamp = Some(Timestamp::new(index as u32, 0));
-        self.write(
-            0,
-            t,
-            &encode(&scene_update(e, self.rod_diameter, stamp), &self.path)?,
-        )?;
-        let tf = FrameTransform {
-            timestamp: stamp,
-            parent_frame_id: "world".into(),
-            child_frame_id: "rod".into(),
-            translation: Some(FgVector3 {
-                x: 0.0,
-                y: 0.0,
-                z: 0.0,
-            }),
-            rotation: Some(Quaternion {
-                x: 0.0,
-                y: 0.0,
-                z: 0.0,
-                w: 1.0,
-            }),
-        };
-        self.write(1, t, &encode(&tf, &self.path)?)?;
-        let scalars = self.json("encoding the scalars", &Scalars::of(index, e))?;
-        self.write(2, t, &scalars)?;
-        let state = StateMessage {
-            index,
-            model: self.model.clone(),
-            state: e.state.clone(),
-        };
-        let state = self.json("encoding the state", &state)?;
-        self.write(3, t, &state)?;
+        let messages = state_messages(index, e, &self.model, self.rod_diameter, &self.path)?;
+        for (channel, data) in messages.iter().enumerate() {
+            self.write(channel, t, data)?;
+        }
         self.count += 1;
         Ok(())
     }
