@@ -4,6 +4,7 @@ use super::progress::Progress;
 use crate::io::json::write_pretty;
 use crate::io::map_files::{LineFolder, Partial, merge as merge_parts, trace_cached};
 use crate::io::output::{OutputKind, output_kind};
+use crate::linalg::counters::{Work, within};
 use crate::scene::MapSpec;
 use crate::scene::{Job, Scene};
 use crate::study::boundary::Traced;
@@ -188,9 +189,12 @@ fn map_plane(
 /// The boundary walk of a plane, with a spinner (one sequential computation:
 /// shard 0 carries it).
 fn trace(scene: &Scene, spec: &MapSpec, segments: Option<usize>, cache: &Path) -> Result<Traced> {
-    let spinner = Progress::spinner("boundary points");
-    let t = trace_cached(scene, spec, segments, cache, &|k, on| {
-        spinner.item(format!("tracing the boundary: point {k}, on {on}"));
+    let work = Work::new();
+    let spinner = Progress::spinner("boundary points", &work);
+    let t = within(Some(&work), || {
+        trace_cached(scene, spec, segments, cache, &|k, on| {
+            spinner.item(format!("tracing the boundary: point {k}, on {on}"));
+        })
     })?;
     spinner.finish();
     Ok(t)
@@ -204,15 +208,18 @@ fn compute_lines(
     segments: Option<usize>,
     cache: &Path,
 ) -> Result<Vec<Line>> {
-    let progress = Progress::bar(indices.len() as u64, "lines");
+    let work = Work::new();
+    let progress = Progress::bar(indices.len() as u64, "lines", &work);
     let store = LineFolder::create(cache, scene, spec, segments)?;
-    let lines = crate::study::map::compute_lines(scene, spec, indices, segments, &store, &|l| {
-        progress.item(format!(
-            "{} = {:.4}: {} good intervals",
-            spec.parameter.name(),
-            l.value,
-            l.intervals.len()
-        ));
+    let lines = within(Some(&work), || {
+        crate::study::map::compute_lines(scene, spec, indices, segments, &store, &|l| {
+            progress.item(format!(
+                "{} = {:.4}: {} good intervals",
+                spec.parameter.name(),
+                l.value,
+                l.intervals.len()
+            ));
+        })
     })?;
     progress.finish();
     Ok(lines)

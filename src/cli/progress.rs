@@ -1,9 +1,9 @@
 //! Progress of long commands: an indicatif bar on a terminal, plain lines on
 //! stderr otherwise (a Slurm log, a pipe), and in both a heartbeat from the
-//! solvers' counters so that one long solve shows it is moving: the first
+//! run's work counters (`linalg::counters::Work`) so that one long solve shows it is moving: the first
 //! report comes within a second, whatever the computation.
 
-use crate::linalg::counters;
+use crate::linalg::counters::Work;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -21,6 +21,8 @@ struct Shared {
     last: Mutex<String>,
     /// When the last item finished.
     since: Mutex<Instant>,
+    /// The run's work, counted by its solvers.
+    work: Arc<Work>,
 }
 
 /// A progress display with a heartbeat; finish it (or drop it) when done.
@@ -40,8 +42,8 @@ fn next_report(t: f64) -> f64 {
 }
 
 impl Progress {
-    /// A spinner counting `unit` (e.g. "equilibria").
-    pub fn spinner(unit: &'static str) -> Self {
+    /// A spinner counting `unit` (e.g. "equilibria") of the run doing `work`.
+    pub fn spinner(unit: &'static str, work: &Arc<Work>) -> Self {
         let bar = ProgressBar::new_spinner();
         bar.set_style(
             ProgressStyle::with_template(&format!(
@@ -49,11 +51,11 @@ impl Progress {
             ))
             .expect("a valid template"),
         );
-        Self::start(bar, unit, None)
+        Self::start(bar, unit, None, work)
     }
 
-    /// A bar of `len` `unit` (e.g. "lines").
-    pub fn bar(len: u64, unit: &'static str) -> Self {
+    /// A bar of `len` `unit` (e.g. "lines") of the run doing `work`.
+    pub fn bar(len: u64, unit: &'static str, work: &Arc<Work>) -> Self {
         let bar = ProgressBar::new(len);
         bar.set_style(
             ProgressStyle::with_template(&format!(
@@ -61,15 +63,16 @@ impl Progress {
             ))
             .expect("a valid template"),
         );
-        Self::start(bar, unit, Some(len))
+        Self::start(bar, unit, Some(len), work)
     }
 
-    fn start(bar: ProgressBar, unit: &'static str, len: Option<u64>) -> Self {
+    fn start(bar: ProgressBar, unit: &'static str, len: Option<u64>, work: &Arc<Work>) -> Self {
         let shared = Arc::new(Shared {
             done: AtomicBool::new(false),
             count: AtomicUsize::new(0),
             last: Mutex::new(String::new()),
             since: Mutex::new(Instant::now()),
+            work: work.clone(),
         });
         let terminal = std::io::stderr().is_terminal();
         if terminal {
@@ -118,15 +121,15 @@ impl Drop for Progress {
 /// 1 s, 5 s, 15 s, 30 s and then every minute.
 fn heartbeat(bar: &ProgressBar, shared: &Shared, unit: &str, len: Option<u64>, terminal: bool) {
     let begin = Instant::now();
-    let first = counters::iterations();
+    let first = shared.work.iterations();
     let mut due = next_report(0.0);
     while !shared.done.load(Ordering::Relaxed) {
         std::thread::sleep(Duration::from_millis(50));
         let t = begin.elapsed().as_secs_f64();
-        let iterations = counters::iterations() - first;
+        let iterations = shared.work.iterations() - first;
         let solving = format!(
             "{iterations} Newton iterations, relative gradient {:.2e}",
-            counters::residual()
+            shared.work.residual()
         );
         let last = shared
             .last

@@ -10,6 +10,7 @@ use crate::io::output::{Output, OutputKind, output_kind};
 use crate::io::plot::{PlotPoint, bifurcation_diagram};
 use crate::io::recording::Recorder;
 use crate::io::summary::{Summary, print_equilibrium, print_events};
+use crate::linalg::counters::{Work, within};
 use crate::model::rod::RodModel;
 use crate::scene::{Job, Scene};
 use crate::study::error::StudyError;
@@ -65,7 +66,8 @@ pub fn run(
         }
         None => None,
     };
-    let progress = Progress::spinner("equilibria");
+    let work = Work::new();
+    let progress = Progress::spinner("equilibria", &work);
     let mut watch = Watch {
         outputs: &mut outputs,
         progress: &progress,
@@ -73,7 +75,7 @@ pub fn run(
         events: Vec::new(),
         live: live.as_mut(),
     };
-    let result = run_scene(&scene, segments, &mut watch);
+    let result = within(Some(&work), || run_scene(&scene, segments, &mut watch));
     let mut located = watch.events;
     progress.finish();
     let mut out: Box<dyn Write> = if on_stdout {

@@ -8,6 +8,7 @@ use crate::io::convergence_plot::{Series, convergence_plot};
 use crate::io::json::write_pretty;
 use crate::io::output::{OutputKind, output_kind};
 use crate::io::verify_file::read_solutions;
+use crate::linalg::counters::{Work, within};
 use crate::model::rod::Parameter;
 use crate::report::auto_events::{self, compare_with_continuation};
 use crate::report::verify::{details, markdown, summary};
@@ -178,11 +179,14 @@ pub fn verify(a: Args) -> Result<()> {
         threads,
         a.allow_large,
     )?;
-    let progress = Progress::bar(solutions.len() as u64, "solutions");
+    let work = Work::new();
+    let progress = Progress::bar(solutions.len() as u64, "solutions", &work);
     let run = || {
-        verify_all(&base, &solutions, &options, &|c: &SolutionCheck| {
-            progress.item(format!("{}: {:?}", c.given.name, c.verdict));
-            Ok(())
+        within(Some(&work), || {
+            verify_all(&base, &solutions, &options, &|c: &SolutionCheck| {
+                progress.item(format!("{}: {:?}", c.given.name, c.verdict));
+                Ok(())
+            })
         })
     };
     let checks = match a.threads {

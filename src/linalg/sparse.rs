@@ -215,7 +215,7 @@ impl Ldlt {
 
     /// Factor A (upper values on the pattern). Err on a zero pivot.
     pub fn factor(&mut self, values: &[f64]) -> Result<(), SingularPivot> {
-        crate::linalg::counters::FACTORIZATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        crate::linalg::counters::add_factorization();
         let n = self.col_ptr.len() - 1;
         let a = SparseColMatRef::new(
             SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx),

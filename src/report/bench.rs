@@ -6,7 +6,7 @@ use crate::geometry::closure::ray_closure;
 use crate::geometry::distance::min_self_distance;
 use crate::geometry::knot::knot_type;
 use crate::geometry::writhe::{try_writhe_closed, writhe_closed};
-use crate::linalg::counters::{FACTORIZATIONS, NEWTON_ITERATIONS};
+use crate::linalg::counters::{Work, within};
 use crate::linalg::eigen::lowest_eigenvalues;
 use crate::linalg::sparse::Ldlt;
 use crate::model::energy::RodEnergy;
@@ -17,7 +17,6 @@ use nalgebra::Vector3;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 /// One timed workload.
@@ -72,18 +71,16 @@ fn peak_bytes() -> u64 {
 }
 
 fn timed(name: &str, segments: usize, f: impl FnOnce() -> Result<()>) -> Result<Workload> {
-    let (it0, f0) = (
-        NEWTON_ITERATIONS.load(Ordering::Relaxed),
-        FACTORIZATIONS.load(Ordering::Relaxed),
-    );
+    // each workload counts its own work
+    let work = Work::new();
     let t = Instant::now();
-    f().with_context(|| format!("workload {name}"))?;
+    within(Some(&work), f).with_context(|| format!("workload {name}"))?;
     Ok(Workload {
         name: name.into(),
         segments,
         seconds: t.elapsed().as_secs_f64(),
-        newton_iterations: NEWTON_ITERATIONS.load(Ordering::Relaxed) - it0,
-        factorizations: FACTORIZATIONS.load(Ordering::Relaxed) - f0,
+        newton_iterations: work.iterations(),
+        factorizations: work.factorizations(),
         peak_bytes: peak_bytes(),
         accuracy: None,
     })

@@ -351,8 +351,7 @@ impl<'a> Tracer<'a> {
         let mut offset = vec![0.0; tq.len()];
         let mut p = p_pred;
         for it in 0..=self.settings.max_corrector_iterations {
-            crate::linalg::counters::NEWTON_ITERATIONS
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            crate::linalg::counters::add_iteration();
             let (rel, converged) = self.linearise(&state)?;
             let c = self.weight * self.dot_q(&tq, &offset) + tp * (p - p_pred);
             if converged && c.abs() <= 1e-10 * sigma.abs().max(1e-12) {
@@ -414,8 +413,7 @@ impl<'a> Tracer<'a> {
         // the clamps' move as a velocity: ∂_c∇E is linear in it
         let velocity = from.clamps.velocity_to(&target, from);
         for it in 0..=self.settings.max_corrector_iterations {
-            crate::linalg::counters::NEWTON_ITERATIONS
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            crate::linalg::counters::add_iteration();
             let (rel, converged) = self.linearise(&state)?;
             if it > 0 && converged {
                 return Ok(self.point_at(state, it, rel, None, 0.0));

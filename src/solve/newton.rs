@@ -73,8 +73,7 @@ impl Newton {
         iteration: usize,
         tol: f64,
     ) -> Result<(GradientInfo, Judgement), SolveError> {
-        crate::linalg::counters::NEWTON_ITERATIONS
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        crate::linalg::counters::add_iteration();
         let info = energy.hessian(state, &mut self.grad, &mut self.values);
         let gnorm = norm(&self.grad);
         if !info.energy.is_finite() || !gnorm.is_finite() {

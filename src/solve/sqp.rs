@@ -158,6 +158,8 @@ pub fn minimize(
     let mut sqp = Sqp::new(energy, ldlt, contact, state, settings);
     for it in 0..=settings.max_iterations {
         sqp.linearise(it)?;
+        crate::linalg::counters::add_iteration();
+        crate::linalg::counters::set_residual(sqp.res.rel);
         if sqp.converged() {
             return Ok(sqp.converged_report());
         }

@@ -410,6 +410,8 @@ pub fn compute_lines(
     on_line: &(dyn Fn(&Line) + Sync),
 ) -> Result<Vec<Line>> {
     use rayon::prelude::*;
+    // the workers count into the run's work
+    let work = crate::linalg::counters::current();
     let mut lines: Vec<Line> = indices
         .par_iter()
         .map(|&k| -> Result<Line> {
@@ -418,7 +420,8 @@ pub fn compute_lines(
                 on_line(&l);
                 return Ok(l);
             }
-            let l = line(scene, spec, k, segments);
+            let l =
+                crate::linalg::counters::within(work.as_ref(), || line(scene, spec, k, segments));
             store.put(&l).map_err(StudyError::Observer)?;
             on_line(&l);
             Ok(l)

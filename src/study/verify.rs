@@ -1517,11 +1517,15 @@ pub fn verify_all(
             "verify: --segments must be at least 4".into(),
         ));
     }
+    // the workers count into the run's work
+    let work = crate::linalg::counters::current();
     let mut checks: Vec<SolutionCheck> = solutions
         .par_iter()
         .enumerate()
         .map(|(k, s)| {
-            let c = verify_solution(base, k, s, options);
+            let c = crate::linalg::counters::within(work.as_ref(), || {
+                verify_solution(base, k, s, options)
+            });
             on_done(&c)?;
             Ok(c)
         })
