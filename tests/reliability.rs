@@ -105,18 +105,13 @@ fn every_shipped_scene_is_within_the_default_budget() {
     }
 }
 
-#[test]
-fn a_long_solve_prints_progress_within_seconds() {
-    // a stiff rod at N = 2000: a thousand slow Newton iterations
-    let dir = temp_dir("progress");
-    let path = write(
-        &dir,
-        "stiff.toml",
-        &SMALL.replace("segments = 100", "segments = 2000\nrod_diameter = 1e-5"),
-    );
+/// The first line a run of `scene` prints on its standard error (a pipe:
+/// its progress as plain lines), and how long it took to come; the run is
+/// then stopped.
+fn first_progress_line(scene: &str) -> (String, Duration) {
     let t = Instant::now();
     let mut child = Command::new(env!("CARGO_BIN_EXE_knotrod"))
-        .args(["run", &path, "--no-record"])
+        .args(["run", scene, "--no-record"])
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -128,9 +123,7 @@ fn a_long_solve_prints_progress_within_seconds() {
     let waited = t.elapsed();
     let _ = child.kill();
     let _ = child.wait();
-    assert!(iterations_in(&first) > 0, "{first}");
-    // due at 1 s; the bound leaves room for a loaded machine
-    assert!(waited < Duration::from_secs(15), "{waited:?}");
+    (first, waited)
 }
 
 /// The solver iterations a progress line reports ("… 123 Newton iterations …").
@@ -147,21 +140,25 @@ fn iterations_in(line: &str) -> usize {
 }
 
 #[test]
+fn a_long_solve_prints_progress_within_seconds() {
+    // a stiff rod at N = 2000: a thousand slow Newton iterations
+    let dir = temp_dir("progress");
+    let path = write(
+        &dir,
+        "stiff.toml",
+        &SMALL.replace("segments = 100", "segments = 2000\nrod_diameter = 1e-5"),
+    );
+    let (first, waited) = first_progress_line(&path);
+    assert!(iterations_in(&first) > 0, "{first}");
+    // due at 1 s; the bound leaves room for a loaded machine
+    assert!(waited < Duration::from_secs(15), "{waited:?}");
+}
+
+#[test]
 fn the_heartbeat_counts_the_contact_solver_too() {
     // the trefoil relaxed onto the rays: a second of SQP with contact before
     // the first equilibrium (its iterations were not counted before)
-    let mut child = Command::new(env!("CARGO_BIN_EXE_knotrod"))
-        .args(["run", "scenes/trefoil_contact_start.toml", "--no-record"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut first = String::new();
-    BufReader::new(child.stderr.take().unwrap())
-        .read_line(&mut first)
-        .unwrap();
-    let _ = child.kill();
-    let _ = child.wait();
+    let (first, _) = first_progress_line("scenes/trefoil_contact_start.toml");
     assert!(iterations_in(&first) > 0, "{first}");
 }
 

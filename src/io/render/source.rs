@@ -142,11 +142,13 @@ fn choose(path: &Path, pick: &Pick, scalars: &[Key], events: &[Event]) -> Result
         Pick::Index(k) => {
             if scalars.iter().any(|s| s.index == *k) {
                 Ok((*k, String::new()))
+            } else if scalars.is_empty() {
+                Err(bad(format!("--index {k}: the file holds no states")))
             } else {
                 Err(bad(format!(
                     "--index {k}: no such state (the file holds {} states, 0 to {})",
                     scalars.len(),
-                    scalars.len().saturating_sub(1)
+                    scalars.len() - 1
                 )))
             }
         }
