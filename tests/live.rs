@@ -10,20 +10,12 @@ use std::time::{Duration, Instant};
 use tungstenite::client::IntoClientRequest;
 use tungstenite::{Message, connect};
 
-/// A run that serves its channels live on a free port: the child and its
-/// port (read from the line it prints before computing).
-fn start_live(scene: &str, record: &std::path::Path) -> (std::process::Child, u16) {
+/// `knotrod ARGS --live 127.0.0.1:0`: the child and its port (read from the
+/// line it prints before computing).
+fn start_live(args: &[&str]) -> (std::process::Child, u16) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_knotrod"))
-        .args([
-            "run",
-            scene,
-            "--segments",
-            "60",
-            "--record",
-            record.to_str().unwrap(),
-            "--live",
-            "127.0.0.1:0",
-        ])
+        .args(args)
+        .args(["--live", "127.0.0.1:0"])
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -42,82 +34,123 @@ fn start_live(scene: &str, record: &std::path::Path) -> (std::process::Child, u1
     (child, port)
 }
 
+/// A Foxglove WebSocket client (the SDK's protocol, foxglove.sdk.v1).
+struct Client {
+    ws: tungstenite::WebSocket<tungstenite::stream::MaybeTlsStream<std::net::TcpStream>>,
+    /// Advertised channels by id.
+    channels: std::collections::BTreeMap<u64, serde_json::Value>,
+    /// The topics to subscribe to once advertised, in subscription order
+    /// (subscription k + 1 is topic k).
+    wanted: Vec<&'static str>,
+    subscribed: bool,
+}
+
+impl Client {
+    fn connect(port: u16, wanted: Vec<&'static str>) -> Client {
+        let mut request = format!("ws://127.0.0.1:{port}")
+            .into_client_request()
+            .unwrap();
+        request
+            .headers_mut()
+            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
+        let (ws, response) = connect(request).expect("the live view accepts a client");
+        assert_eq!(
+            response.headers()["Sec-WebSocket-Protocol"],
+            "foxglove.sdk.v1"
+        );
+        if let tungstenite::stream::MaybeTlsStream::Plain(s) = ws.get_ref() {
+            s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+        }
+        Client {
+            ws,
+            channels: Default::default(),
+            wanted,
+            subscribed: false,
+        }
+    }
+
+    /// The advertised channel of `topic`.
+    fn channel(&self, topic: &str) -> &serde_json::Value {
+        self.channels
+            .values()
+            .find(|c| c["topic"] == topic)
+            .unwrap_or_else(|| panic!("{topic} not advertised: {:?}", self.channels))
+    }
+
+    /// The next message on a subscribed topic: (topic index in `wanted`, its
+    /// data); None once the server closes.
+    fn next(&mut self) -> Option<(usize, Vec<u8>)> {
+        loop {
+            match self.ws.read().ok()? {
+                Message::Text(text) => {
+                    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+                    if v["op"] == "advertise" {
+                        for c in v["channels"].as_array().unwrap() {
+                            self.channels.insert(c["id"].as_u64().unwrap(), c.clone());
+                        }
+                    }
+                    let all = self
+                        .wanted
+                        .iter()
+                        .all(|w| self.channels.values().any(|c| c["topic"] == *w));
+                    if !self.subscribed && all {
+                        let subscriptions: Vec<serde_json::Value> = self
+                            .wanted
+                            .iter()
+                            .enumerate()
+                            .map(|(k, w)| {
+                                serde_json::json!({"id": k + 1, "channelId": self.channel(w)["id"]})
+                            })
+                            .collect();
+                        let subscribe = serde_json::json!({
+                            "op": "subscribe",
+                            "subscriptions": subscriptions,
+                        });
+                        self.ws.send(Message::text(subscribe.to_string())).unwrap();
+                        self.subscribed = true;
+                    }
+                }
+                // a message: opcode 1, subscription id (u32), time (u64), data
+                Message::Binary(bytes) if bytes.first() == Some(&1) => {
+                    let subscription = u32::from_le_bytes(bytes[1..5].try_into().unwrap());
+                    return Some((subscription as usize - 1, bytes[13..].to_vec()));
+                }
+                _ => {}
+            }
+        }
+    }
+}
+
 #[test]
 fn a_foxglove_client_sees_the_running_computation() {
     let dir = common::temp_dir("live");
     let scene = "scenes/fig3_kirchhoff.toml";
     let live_record = dir.join("live.mcap");
-    let (mut child, port) = start_live(scene, &live_record);
-    let mut request = format!("ws://127.0.0.1:{port}")
-        .into_client_request()
-        .unwrap();
-    request
-        .headers_mut()
-        .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
-    let (mut ws, response) = connect(request).expect("the live view accepts a client");
-    assert_eq!(
-        response.headers()["Sec-WebSocket-Protocol"],
-        "foxglove.sdk.v1"
-    );
-    if let tungstenite::stream::MaybeTlsStream::Plain(s) = ws.get_ref() {
-        s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
-    }
-    // the server names itself, then advertises the recording's channels
-    let mut topics = std::collections::BTreeMap::new();
-    let mut subscribed = false;
+    let record = live_record.to_str().unwrap();
+    let (mut child, port) = start_live(&["run", scene, "--segments", "60", "--record", record]);
+    let mut client = Client::connect(port, vec!["/rod/scene", "/events"]);
     let (mut scenes, mut events) = (Vec::new(), Vec::new());
     let start = Instant::now();
     while (scenes.is_empty() || events.is_empty()) && start.elapsed() < Duration::from_secs(60) {
-        let Ok(message) = ws.read() else { break };
-        match message {
-            Message::Text(text) => {
-                let v: serde_json::Value = serde_json::from_str(&text).unwrap();
-                if v["op"] == "advertise" {
-                    for c in v["channels"].as_array().unwrap() {
-                        topics.insert(c["id"].as_u64().unwrap(), c.clone());
-                    }
-                }
-                if !subscribed && topics.len() == 5 {
-                    let id = |topic: &str| {
-                        topics
-                            .iter()
-                            .find(|(_, c)| c["topic"] == topic)
-                            .map(|(id, _)| *id)
-                            .unwrap_or_else(|| panic!("{topic} not advertised: {topics:?}"))
-                    };
-                    assert_eq!(
-                        topics[&id("/rod/scene")]["schemaName"],
-                        "foxglove.SceneUpdate"
-                    );
-                    assert_eq!(topics[&id("/events")]["encoding"], "json");
-                    let subscribe = serde_json::json!({
-                        "op": "subscribe",
-                        "subscriptions": [
-                            {"id": 1, "channelId": id("/rod/scene")},
-                            {"id": 2, "channelId": id("/events")},
-                        ]
-                    });
-                    ws.send(Message::text(subscribe.to_string())).unwrap();
-                    subscribed = true;
-                }
-            }
-            // a message: opcode 1, subscription id (u32), time (u64), data
-            Message::Binary(bytes) if bytes.first() == Some(&1) => {
-                let subscription = u32::from_le_bytes(bytes[1..5].try_into().unwrap());
-                let data = &bytes[13..];
-                match subscription {
-                    1 => scenes.push(
-                        <foxglove::messages::SceneUpdate as prost::Message>::decode(data)
-                            .expect("a foxglove.SceneUpdate"),
-                    ),
-                    2 => events.push(serde_json::from_slice::<serde_json::Value>(data).unwrap()),
-                    other => panic!("subscription {other} never asked for"),
-                }
-            }
-            _ => {}
+        let Some((topic, data)) = client.next() else {
+            break;
+        };
+        match topic {
+            0 => scenes.push(
+                <foxglove::messages::SceneUpdate as prost::Message>::decode(&data[..])
+                    .expect("a foxglove.SceneUpdate"),
+            ),
+            _ => events.push(serde_json::from_slice::<serde_json::Value>(&data).unwrap()),
         }
     }
-    let _ = ws.close(None);
+    // the server advertised the recording's channels and schemas
+    assert_eq!(client.channels.len(), 5);
+    assert_eq!(
+        client.channel("/rod/scene")["schemaName"],
+        "foxglove.SceneUpdate"
+    );
+    assert_eq!(client.channel("/events")["encoding"], "json");
+    let _ = client.ws.close(None);
     let status = child.wait().unwrap();
     assert!(status.success(), "the live run failed");
     assert!(!scenes.is_empty(), "no scene came while the run computed");
@@ -143,6 +176,55 @@ fn a_foxglove_client_sees_the_running_computation() {
         std::fs::read(&live_record).unwrap() == std::fs::read(&plain_record).unwrap(),
         "the recording differs with --live"
     );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_map_shows_its_lines_as_they_are_done() {
+    // the Figure 7 island, 4 lines at N = 40: the boundary walk first, then
+    // the lines in parallel, each sent as it is done
+    let dir = common::temp_dir("live-map");
+    let mut text = std::fs::read_to_string("scenes/fig7_island_kirchhoff.toml").unwrap();
+    for (from, to) in [
+        ("segments = 100", "segments = 40"),
+        ("range = [0.65, 1.1]", "range = [0.74, 0.95]"),
+        ("range = [0.04, 0.30]", "range = [0.12, 0.18]"),
+        ("lines = 27", "lines = 4"),
+        ("grid_columns = 91", "grid_columns = 11"),
+        ("polish = true", "polish = false"),
+    ] {
+        assert!(text.contains(from), "{from}");
+        text = text.replace(from, to);
+    }
+    let scene = dir.join("map.toml");
+    std::fs::write(&scene, text).unwrap();
+    let json = dir.join("map.json");
+    let (mut child, port) = start_live(&[
+        "map",
+        scene.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    let mut client = Client::connect(port, vec!["/map/points", "/map/lines"]);
+    let (mut points, mut lines) = (0, Vec::new());
+    while let Some((topic, data)) = client.next() {
+        let v: serde_json::Value = serde_json::from_slice(&data).unwrap();
+        if topic == 0 {
+            assert!(v["along"].is_f64() && v["class"].is_string(), "{v}");
+            points += 1;
+        } else {
+            lines.push(v);
+        }
+    }
+    assert!(child.wait().unwrap().success(), "the live map failed");
+    // every line came, with the intervals the map file holds
+    let map: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(lines.len(), 4, "{lines:?}");
+    assert!(points > 4 * 10, "{points} points");
+    for l in &lines {
+        let k = l["line"].as_u64().unwrap() as usize;
+        assert_eq!(l["intervals"], map["lines"][k]["intervals"], "line {k}");
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }
 

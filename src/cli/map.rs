@@ -2,6 +2,7 @@
 
 use super::progress::Progress;
 use crate::io::json::write_pretty;
+use crate::io::live::LiveMap;
 use crate::io::map_files::{LineFolder, Partial, merge as merge_parts, trace_cached};
 use crate::io::output::{OutputKind, output_kind};
 use crate::linalg::counters::{Work, within};
@@ -19,6 +20,7 @@ pub fn map(
     json: Option<PathBuf>,
     shard: Option<&str>,
     segments: Option<usize>,
+    live: Option<&str>,
     allow_large: bool,
 ) -> Result<()> {
     let scene = Scene::load(path)?;
@@ -48,13 +50,43 @@ pub fn map(
         Some(s) => Some(parse_shard(s)?),
         None => None,
     };
+    let live = match live {
+        Some(address) => {
+            let l = LiveMap::start(address)?;
+            let host = address.rsplit_once(':').map_or(address, |(h, _)| h);
+            eprintln!(
+                "live view at ws://{host}:{} (Foxglove: Open connection, Foxglove WebSocket; \
+                 plot /map/points.value against /map/points.along)",
+                l.port()
+            );
+            Some(l)
+        }
+        None => None,
+    };
+    let result = map_scene(&scene, &spec, &name, &json, shard, segments, live.as_ref());
+    if let Some(l) = live {
+        l.stop();
+    }
+    result
+}
+
+/// Map a scene's plane or slices (see [`map`]).
+fn map_scene(
+    scene: &Scene,
+    spec: &MapSpec,
+    name: &str,
+    json: &Path,
+    shard: Option<(usize, usize)>,
+    segments: Option<usize>,
+    live: Option<&LiveMap>,
+) -> Result<()> {
     let Some(slices) = spec.slices.clone() else {
-        return map_plane(&scene, &name, &json, shard, segments).map(|_| ());
+        return map_plane(scene, name, json, shard, segments, live).map(|_| ());
     };
     // a 3D map: one plane map per slice, each with its own file and cache
     let mut maps = Vec::new();
     for (k, v) in slices.values.iter().enumerate() {
-        let slice = slices.scene(&scene, k);
+        let slice = slices.scene(scene, k);
         let stem = json.file_stem().and_then(|s| s.to_str()).unwrap_or("map");
         let file = json.with_file_name(format!("{stem}_slice{k}.json"));
         writeln!(
@@ -68,6 +100,7 @@ pub fn map(
             &file,
             shard,
             segments,
+            live,
         )? {
             maps.push(m);
         }
@@ -75,9 +108,9 @@ pub fn map(
     if shard.is_some() {
         return Ok(());
     }
-    let map3 = crate::study::map::assemble_3d(&name, &slices, maps);
-    write_pretty(&json, &map3)?;
-    print_map3(&name, &map3, &json)
+    let map3 = crate::study::map::assemble_3d(name, &slices, maps);
+    write_pretty(json, &map3)?;
+    print_map3(name, &map3, json)
 }
 
 /// Join partial maps into one map, written to `json`.
@@ -136,6 +169,7 @@ fn map_plane(
     json: &Path,
     shard: Option<(usize, usize)>,
     segments: Option<usize>,
+    live: Option<&LiveMap>,
 ) -> Result<Option<Map>> {
     let spec = scene
         .map
@@ -155,7 +189,7 @@ fn map_plane(
         Some((i, _)) if i != 0 => None,
         _ => Some(trace(scene, &spec, segments, &cache)?),
     };
-    let lines = compute_lines(scene, &spec, &indices, segments, &cache)?;
+    let lines = compute_lines(scene, &spec, &indices, segments, &cache, live)?;
     match shard {
         Some(sh) => {
             let part = Partial {
@@ -207,12 +241,19 @@ fn compute_lines(
     indices: &[usize],
     segments: Option<usize>,
     cache: &Path,
+    live: Option<&LiveMap>,
 ) -> Result<Vec<Line>> {
     let work = Work::new();
     let progress = Progress::bar(indices.len() as u64, "lines", &work);
     let store = LineFolder::create(cache, scene, spec, segments)?;
     let lines = within(Some(&work), || {
         crate::study::map::compute_lines(scene, spec, indices, segments, &store, &|l| {
+            if let Some(live) = live
+                && let Err(e) = live.line(l)
+            {
+                // the map goes on: the live view is a view
+                eprintln!("live view: {e}");
+            }
             progress.item(format!(
                 "{} = {:.4}: {} good intervals",
                 spec.parameter.name(),

@@ -139,6 +139,11 @@ pub enum Command {
         /// Override the scene's number of segments.
         #[arg(long)]
         segments: Option<usize>,
+        /// Serve each line's points and intervals live to the Foxglove app
+        /// (WebSocket) at HOST:PORT (default 127.0.0.1:8765; port 0: any free
+        /// port, printed).
+        #[arg(long, num_args = 0..=1, default_missing_value = crate::io::live::DEFAULT_ADDRESS)]
+        live: Option<String>,
         /// Map even when the predicted memory or CPU time exceeds `[budget]`.
         #[arg(long)]
         allow_large: bool,
@@ -252,8 +257,16 @@ pub fn main_with(cli: Cli) -> Result<()> {
             json,
             shard,
             segments,
+            live,
             allow_large,
-        } => map::map(&scene, json, shard.as_deref(), segments, allow_large),
+        } => map::map(
+            &scene,
+            json,
+            shard.as_deref(),
+            segments,
+            live.as_deref(),
+            allow_large,
+        ),
         Command::Merge { parts, json } => map::merge(&parts, &json),
         Command::Bench { scenes, json } => reports::bench(&scenes, json),
         Command::Validate { scenes } => reports::validate(&scenes),

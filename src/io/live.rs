@@ -4,12 +4,13 @@
 //! `/rod/scalars`, `/rod/state`, `/events`), so the Foxglove app's 3D panel
 //! and plots show the rod, the scalars and the events while they come. The
 //! server has a context of its own: nothing else logs to it, and the
-//! recording is written as without it.
+//! recording is written as without it. A map's live view (`map --live`)
+//! sends each line's points and intervals as the line is done.
 
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
 use crate::io::error::{IoError, Result};
-use crate::io::recording::writer::{channel_specs, state_messages};
+use crate::io::recording::writer::{ChannelSpec, channel_specs, state_messages};
 use crate::model::rod::RodModel;
 use foxglove::{Context, PartialMetadata, RawChannel, WebSocketServer, WebSocketServerHandle};
 use std::path::Path;
@@ -17,19 +18,6 @@ use std::sync::Arc;
 
 /// Where the live view listens unless told: loopback, Foxglove's port.
 pub const DEFAULT_ADDRESS: &str = "127.0.0.1:8765";
-
-/// A running live view.
-pub struct Live {
-    server: WebSocketServerHandle,
-    /// The context the server and channels live in (they hold it weakly:
-    /// without this, clients would be greeted and nothing advertised).
-    _context: Arc<Context>,
-    /// The channels, in the order of the recording's.
-    channels: Vec<Arc<RawChannel>>,
-    model: RodModel,
-    rod_diameter: f64,
-    count: u64,
-}
 
 /// A failure of the live view, named by its address.
 fn failed(address: &str, reason: String) -> IoError {
@@ -56,14 +44,22 @@ pub fn parse_address(address: &str) -> Result<(String, u16)> {
     Ok((host.to_string(), port))
 }
 
-impl Live {
-    /// Start serving at `address` (`HOST:PORT`) the states of `model`'s rod
-    /// of diameter `rod_diameter`.
-    pub fn start(address: &str, model: &RodModel, rod_diameter: f64) -> Result<Live> {
+/// A Foxglove WebSocket server and its channels, in a context of its own.
+struct Server {
+    handle: WebSocketServerHandle,
+    /// The context the server and channels live in (they hold it weakly:
+    /// without this, clients would be greeted and nothing advertised).
+    _context: Arc<Context>,
+    channels: Vec<Arc<RawChannel>>,
+}
+
+impl Server {
+    /// Serve `specs`' channels at `address`.
+    fn start(address: &str, specs: Vec<ChannelSpec>) -> Result<Server> {
         let (host, port) = parse_address(address)?;
         let ctx = Context::new();
         let mut channels = Vec::new();
-        for spec in channel_specs() {
+        for spec in specs {
             let channel = ctx
                 .channel_builder(spec.topic)
                 .message_encoding(spec.message_encoding)
@@ -72,16 +68,49 @@ impl Live {
                 .map_err(|e| failed(address, format!("channel {}: {e}", spec.topic)))?;
             channels.push(channel);
         }
-        let server = WebSocketServer::new()
+        let handle = WebSocketServer::new()
             .name(format!("knotrod {}", env!("CARGO_PKG_VERSION")))
             .context(&ctx)
             .bind(host, port)
             .start_blocking()
             .map_err(|e| failed(address, format!("cannot serve: {e}")))?;
-        Ok(Live {
-            server,
+        Ok(Server {
+            handle,
             _context: ctx,
             channels,
+        })
+    }
+
+    /// Send `data` on channel `k` at log time `index` seconds.
+    fn send(&self, k: usize, data: &[u8], index: u64) {
+        self.channels[k].log_with_meta(data, at(index));
+    }
+
+    /// Stop, once what was sent has gone out to the clients.
+    fn stop(self) {
+        self.handle.stop().wait_blocking();
+    }
+}
+
+/// `value` as JSON bytes for the live view.
+fn json<T: serde::Serialize>(step: &'static str, value: &T) -> Result<Vec<u8>> {
+    serde_json::to_vec(value).map_err(IoError::json(step, Path::new("the live view")))
+}
+
+/// A running live view of a run.
+pub struct Live {
+    server: Server,
+    model: RodModel,
+    rod_diameter: f64,
+    count: u64,
+}
+
+impl Live {
+    /// Start serving at `address` (`HOST:PORT`) the states of `model`'s rod
+    /// of diameter `rod_diameter`.
+    pub fn start(address: &str, model: &RodModel, rod_diameter: f64) -> Result<Live> {
+        Ok(Live {
+            server: Server::start(address, channel_specs().into())?,
             model: model.clone(),
             rod_diameter,
             count: 0,
@@ -90,7 +119,7 @@ impl Live {
 
     /// The port it listens on.
     pub fn port(&self) -> u16 {
-        self.server.port()
+        self.server.handle.port()
     }
 
     /// Publish an equilibrium (log time = its index in seconds, as recorded).
@@ -103,8 +132,8 @@ impl Live {
             self.rod_diameter,
             Path::new("the live view"),
         )?;
-        for (channel, data) in self.channels.iter().zip(&messages) {
-            channel.log_with_meta(data, at(index));
+        for (k, data) in messages.iter().enumerate() {
+            self.server.send(k, data, index);
         }
         self.count += 1;
         Ok(())
@@ -112,11 +141,8 @@ impl Live {
 
     /// Publish an event (at the time of the last state).
     pub fn event(&self, e: &Event) -> Result<()> {
-        let data = serde_json::to_vec(e).map_err(IoError::json(
-            "encoding an event",
-            Path::new("the live view"),
-        ))?;
-        self.channels[4].log_with_meta(&data, at(self.count.saturating_sub(1)));
+        let data = json("encoding an event", e)?;
+        self.server.send(4, &data, self.count.saturating_sub(1));
         Ok(())
     }
 
@@ -128,7 +154,98 @@ impl Live {
 
     /// Stop serving, once what was published has gone out to the clients.
     pub fn stop(self) {
-        self.server.stop().wait_blocking();
+        self.server.stop();
+    }
+}
+
+/// The points of the map's lines as they are computed (`/map/points`).
+pub const MAP_POINTS_TOPIC: &str = "/map/points";
+/// Each finished line: its good intervals (`/map/lines`).
+pub const MAP_LINES_TOPIC: &str = "/map/lines";
+
+const MAP_POINT_SCHEMA: &str = r#"{"title":"knotrod.MapPoint","type":"object","properties":{"line":{"type":"integer"},"value":{"type":"number"},"along":{"type":"number"},"twist":{"type":"number"},"class":{"type":"string"},"good":{"type":"boolean"}}}"#;
+const MAP_LINE_SCHEMA: &str = r#"{"title":"knotrod.MapLine","type":"object","properties":{"line":{"type":"integer"},"value":{"type":"number"},"intervals":{"type":"array"},"error":{"type":"string"}}}"#;
+
+/// One point of a map's line, as the live view sends it.
+#[derive(serde::Serialize)]
+struct MapPoint {
+    line: usize,
+    value: f64,
+    along: f64,
+    twist: f64,
+    class: crate::analysis::class::Class,
+    good: bool,
+}
+
+/// A finished line, as the live view sends it.
+#[derive(serde::Serialize)]
+struct MapLine<'a> {
+    line: usize,
+    value: f64,
+    intervals: &'a [crate::study::map::Interval],
+    error: Option<&'a str>,
+}
+
+/// A running live view of a map: each line's points and intervals as the
+/// line is done (in Foxglove, a Plot of `/map/points.value` against
+/// `/map/points.along` draws the island as it fills in).
+pub struct LiveMap {
+    server: Server,
+}
+
+impl LiveMap {
+    /// Start serving at `address`.
+    pub fn start(address: &str) -> Result<LiveMap> {
+        let spec = |topic, name: &str, schema: &'static str| ChannelSpec {
+            topic,
+            schema: foxglove::Schema::new(name, "jsonschema", schema.as_bytes()),
+            message_encoding: "json",
+        };
+        Ok(LiveMap {
+            server: Server::start(
+                address,
+                vec![
+                    spec(MAP_POINTS_TOPIC, "knotrod.MapPoint", MAP_POINT_SCHEMA),
+                    spec(MAP_LINES_TOPIC, "knotrod.MapLine", MAP_LINE_SCHEMA),
+                ],
+            )?,
+        })
+    }
+
+    /// The port it listens on.
+    pub fn port(&self) -> u16 {
+        self.server.handle.port()
+    }
+
+    /// Publish a finished line (log time: its index in seconds).
+    pub fn line(&self, l: &crate::study::map::Line) -> Result<()> {
+        let at = l.index as u64;
+        for p in &l.points {
+            let point = MapPoint {
+                line: l.index,
+                value: l.value,
+                along: p.along,
+                twist: p.twist,
+                class: p.class,
+                good: p.class == crate::analysis::class::Class::Good,
+            };
+            self.server
+                .send(0, &json("encoding a map point", &point)?, at);
+        }
+        let line = MapLine {
+            line: l.index,
+            value: l.value,
+            intervals: &l.intervals,
+            error: l.error.as_deref(),
+        };
+        self.server
+            .send(1, &json("encoding a map line", &line)?, at);
+        Ok(())
+    }
+
+    /// Stop serving, once what was published has gone out to the clients.
+    pub fn stop(self) {
+        self.server.stop();
     }
 }
 
