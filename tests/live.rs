@@ -300,3 +300,35 @@ fn the_foxglove_layout_names_the_recorded_channels() {
         assert!(placed.contains(&format!("\"{name}\"")), "{name} not placed");
     }
 }
+
+#[test]
+fn verify_shows_each_check_as_it_is_done() {
+    // the Figure 3 branch's 100 shooting points: the first checks come while
+    // the rest are computed; the test stops the run by its pid once it has
+    // seen two
+    let (mut child, port) = start_live(&[
+        "verify",
+        "scenes/verify/branch_100.csv",
+        "--scene",
+        "scenes/appendix_d.toml",
+        "--segments",
+        "40,80,160",
+    ]);
+    let mut client = Client::connect(port, vec!["/verify/checks"]);
+    let mut checks = Vec::new();
+    while checks.len() < 2 {
+        let Some((_, data)) = client.next() else {
+            break;
+        };
+        checks.push(serde_json::from_slice::<serde_json::Value>(&data).unwrap());
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    assert_eq!(checks.len(), 2, "two checks while the verification ran");
+    for c in &checks {
+        // as `verify --json` writes it: the given solution and the verdict
+        assert!(c["given"]["name"].is_string(), "{c}");
+        assert!(!c["verdict"].is_null(), "{c}");
+        assert!(c["index"].as_u64().unwrap() < 100);
+    }
+}

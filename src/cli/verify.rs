@@ -6,6 +6,7 @@ use super::progress::Progress;
 use crate::io::auto::{is_auto_input, read_auto_input};
 use crate::io::convergence_plot::{Series, convergence_plot};
 use crate::io::json::write_pretty;
+use crate::io::live::LiveChecks;
 use crate::io::output::{OutputKind, output_kind};
 use crate::io::verify_file::read_solutions;
 use crate::linalg::counters::{Work, within};
@@ -59,6 +60,11 @@ pub struct Args {
     /// scene's `[budget]`.
     #[arg(long)]
     pub allow_large: bool,
+    /// Serve each solution's check live to the Foxglove app (WebSocket,
+    /// `/verify/checks`) at HOST:PORT (default 127.0.0.1:8765; port 0: any
+    /// free port, printed).
+    #[arg(long, num_args = 0..=1, default_missing_value = crate::io::live::DEFAULT_ADDRESS)]
+    pub live: Option<String>,
 }
 
 /// The machine's cores.
@@ -179,11 +185,32 @@ pub fn verify(a: Args) -> Result<()> {
         threads,
         a.allow_large,
     )?;
+    let live = match &a.live {
+        Some(address) => {
+            let l = LiveChecks::start(address)?;
+            let host = address
+                .rsplit_once(':')
+                .map_or(address.as_str(), |(h, _)| h);
+            eprintln!(
+                "live view at ws://{host}:{} (Foxglove: Open connection, Foxglove WebSocket; \
+                 /verify/checks)",
+                l.port()
+            );
+            Some(l)
+        }
+        None => None,
+    };
     let work = Work::new();
     let progress = Progress::bar(solutions.len() as u64, "solutions", &work);
     let run = || {
         within(Some(&work), || {
             verify_all(&base, &solutions, &options, &|c: &SolutionCheck| {
+                if let Some(l) = &live
+                    && let Err(e) = l.check(c)
+                {
+                    // the checks go on: the live view is a view
+                    eprintln!("live view: {e}");
+                }
                 progress.item(format!("{}: {:?}", c.given.name, c.verdict));
                 Ok(())
             })
@@ -198,6 +225,10 @@ pub fn verify(a: Args) -> Result<()> {
         None => run()?,
     };
     progress.finish();
+    if let Some(l) = live {
+        // what was published reaches the clients before the server goes
+        l.stop();
+    }
     // a JSON or report on standard output keeps it for itself: the table for
     // people goes to standard error
     let mut out: Box<dyn Write> = if dash(&a.json) || dash(&a.report) {

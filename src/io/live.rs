@@ -5,7 +5,8 @@
 //! and plots show the rod, the scalars and the events while they come. The
 //! server has a context of its own: nothing else logs to it, and the
 //! recording is written as without it. A map's live view (`map --live`)
-//! sends each line's points and intervals as the line is done.
+//! sends each line's points and intervals as the line is done, and
+//! `verify --live` each solution's check.
 
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
@@ -253,5 +254,50 @@ impl LiveMap {
 fn at(index: u64) -> PartialMetadata {
     PartialMetadata {
         log_time: Some(index * 1_000_000_000),
+    }
+}
+
+/// Each verified solution, as `verify --json` writes it (`/verify/checks`).
+pub const VERIFY_TOPIC: &str = "/verify/checks";
+
+const CHECK_SCHEMA: &str = r#"{"title":"knotrod.SolutionCheck","type":"object","properties":{"index":{"type":"integer"},"given":{"type":"object"},"verdict":{"type":"string"}}}"#;
+
+/// A running live view of `verify`: each solution's check as it is done.
+pub struct LiveChecks {
+    server: Server,
+}
+
+impl LiveChecks {
+    /// Start serving at `address`.
+    pub fn start(address: &str) -> Result<LiveChecks> {
+        let spec = ChannelSpec {
+            topic: VERIFY_TOPIC,
+            schema: foxglove::Schema::new(
+                "knotrod.SolutionCheck",
+                "jsonschema",
+                CHECK_SCHEMA.as_bytes(),
+            ),
+            message_encoding: "json",
+        };
+        Ok(LiveChecks {
+            server: Server::start(address, vec![spec])?,
+        })
+    }
+
+    /// The port it listens on.
+    pub fn port(&self) -> u16 {
+        self.server.handle.port()
+    }
+
+    /// Publish a solution's check (log time: its index in seconds).
+    pub fn check(&self, c: &crate::study::verify::SolutionCheck) -> Result<()> {
+        let data = json("encoding a check", c)?;
+        self.server.send(0, &data, c.index as u64);
+        Ok(())
+    }
+
+    /// Stop serving, once what was published has gone out to the clients.
+    pub fn stop(self) {
+        self.server.stop();
     }
 }
