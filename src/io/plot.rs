@@ -341,8 +341,10 @@ impl SymLog {
         }
         t.signum() * self.c * (t.abs() * std::f64::consts::LN_10).exp_m1()
     }
-    /// The axis's ticks within (lo, hi) (transformed), nearest zero first:
-    /// 0 and ±{1, 2, 5}·c·10^k, or (linear) multiples of a round step.
+    /// The axis's ticks within (lo, hi) (transformed), in the order they
+    /// are drawn (where they crowd, the first drawn stay): 0, the decades
+    /// ±c·10^k, then ±2c·10^k and ±5c·10^k; or (linear) multiples of a round
+    /// step, nearest zero first.
     fn ticks(&self, lo: f64, hi: f64) -> Vec<f64> {
         let mut keys = Vec::new();
         if self.linear {
@@ -359,13 +361,17 @@ impl SymLog {
                 k += 1.0;
             }
         } else {
+            // zero, the decades, then 2 and 5 times them: where ticks
+            // crowd, the first ones drawn are kept
             keys.push(0.0);
-            for k in 0..12 {
-                for m in [1.0, 2.0, 5.0] {
+            for m in [1.0, 2.0, 5.0] {
+                for k in 0..12 {
                     let v = m * self.c * 10f64.powi(k);
                     keys.extend([self.to(v), self.to(-v)]);
                 }
             }
+            keys.retain(|t| *t > lo && *t < hi);
+            return keys;
         }
         keys.retain(|t| *t > lo && *t < hi);
         keys.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
