@@ -40,7 +40,7 @@ pub fn knot(path: &Path, closed: bool, rays: RayKind, json: Option<PathBuf>) -> 
     });
     let mut out = std::io::stdout().lock();
     match json {
-        Some(p) if p.as_os_str() == "-" => {
+        Some(p) if crate::io::output::is_standard_output(&p) => {
             writeln!(out, "{}", serde_json::to_string_pretty(&answer)?)?
         }
         other => {

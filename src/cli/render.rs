@@ -64,7 +64,7 @@ pub fn render(
         png(&bodies, &picture)?
     };
     crate::io::output::write_file(out, &bytes)?;
-    if out.as_os_str() != "-" {
+    if !crate::io::output::is_standard_output(out) {
         writeln!(
             std::io::stdout().lock(),
             "picture written to {}",

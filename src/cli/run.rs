@@ -6,7 +6,7 @@ use super::progress::Progress;
 use crate::analysis::equilibrium::Equilibrium;
 use crate::analysis::event::Event;
 use crate::io::live::Live;
-use crate::io::output::{Output, OutputKind, output_kind};
+use crate::io::output::{Output, OutputKind, is_standard_output, output_kind};
 use crate::io::plot::{PlotPoint, bifurcation_diagram};
 use crate::io::recording::Recorder;
 use crate::io::summary::{Summary, print_equilibrium, print_events};
@@ -49,7 +49,7 @@ pub fn run(
     let json = json.or(scene.output.json.clone());
     // a summary or recording on standard output (`-`) keeps it for itself:
     // what is printed for people goes to standard error instead
-    let dash = |p: &Path| p.as_os_str() == "-";
+    let dash = is_standard_output;
     let on_stdout =
         json.as_deref().is_some_and(dash) || matches!(&record, Some(Some(p)) if dash(p));
     let mut summary = Summary::new(&scene, &model);
@@ -116,7 +116,7 @@ pub fn run(
     if let Some(file) = summary_out {
         let path = file.path().to_path_buf();
         summary.write(file)?;
-        if path.as_os_str() != "-" {
+        if !is_standard_output(&path) {
             writeln!(out, "summary written to {}", path.display())?;
         }
     }
@@ -224,7 +224,7 @@ impl Outputs {
                     file.display()
                 );
                 anyhow::ensure!(
-                    !(file.as_os_str() == "-" && json.is_some_and(|j| j.as_os_str() == "-")),
+                    !(is_standard_output(&file) && json.is_some_and(is_standard_output)),
                     "--record - and --json -: only one of them can go to standard output"
                 );
                 let text = std::fs::read_to_string(scene_path).unwrap_or_default();

@@ -7,6 +7,7 @@ use crate::io::auto::{is_auto_input, read_auto_input};
 use crate::io::convergence_plot::{Series, convergence_plot};
 use crate::io::json::write_pretty;
 use crate::io::live::LiveChecks;
+use crate::io::output::is_standard_output;
 use crate::io::output::{OutputKind, output_kind};
 use crate::io::verify_file::read_solutions;
 use crate::linalg::counters::{Work, within};
@@ -137,7 +138,7 @@ fn parameter(name: &str) -> Result<Parameter> {
 
 /// Run `knotrod verify`.
 pub fn verify(a: Args) -> Result<()> {
-    let dash = |p: &Option<PathBuf>| p.as_deref().is_some_and(|p| p.as_os_str() == "-");
+    let dash = |p: &Option<PathBuf>| p.as_deref().is_some_and(is_standard_output);
     ensure!(
         !(dash(&a.json) && dash(&a.report)),
         "--json - and --report -: only one of them can go to standard output"

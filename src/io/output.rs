@@ -141,9 +141,14 @@ pub enum OutputKind {
     Stream,
 }
 
+/// Whether `path` names standard output (`-`).
+pub fn is_standard_output(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
 /// How `path` would be written (symbolic links followed).
 pub fn output_kind(path: &Path) -> OutputKind {
-    if path.as_os_str() == "-" {
+    if is_standard_output(path) {
         return OutputKind::Stream;
     }
     match follow_links(path).map(std::fs::metadata) {
@@ -156,7 +161,7 @@ impl Output {
     /// Start writing `path` (its folder created if need be): `-` is standard
     /// output; refused if `path` is a folder or another writer holds it.
     pub fn create(path: &Path) -> Result<Self> {
-        if path.as_os_str() == "-" {
+        if is_standard_output(path) {
             return Ok(Self::stream(path, StreamTo::Stdout(std::io::stdout())));
         }
         let target = follow_links(path)?;
