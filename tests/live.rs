@@ -184,20 +184,7 @@ fn a_map_shows_its_lines_as_they_are_done() {
     // the Figure 7 island, 4 lines at N = 40: the boundary walk first, then
     // the lines in parallel, each sent as it is done
     let dir = common::temp_dir("live-map");
-    let mut text = std::fs::read_to_string("scenes/fig7_island_kirchhoff.toml").unwrap();
-    for (from, to) in [
-        ("segments = 100", "segments = 40"),
-        ("range = [0.65, 1.1]", "range = [0.74, 0.95]"),
-        ("range = [0.04, 0.30]", "range = [0.12, 0.18]"),
-        ("lines = 27", "lines = 4"),
-        ("grid_columns = 91", "grid_columns = 11"),
-        ("polish = true", "polish = false"),
-    ] {
-        assert!(text.contains(from), "{from}");
-        text = text.replace(from, to);
-    }
-    let scene = dir.join("map.toml");
-    std::fs::write(&scene, text).unwrap();
+    let scene = crate::maps::small_map_scene(&dir);
     let json = dir.join("map.json");
     let (mut child, port) = start_live(&[
         "map",

@@ -23,7 +23,9 @@ fn scene_variant(from: &str, dir: &Path, name: &str, replace: &[(&str, &str)]) -
     p
 }
 
-fn small_map_scene(dir: &Path) -> PathBuf {
+/// The Figure 7 island at N = 40, 4 lines, unpolished: a map in seconds
+/// (also the live view's test map).
+pub(crate) fn small_map_scene(dir: &Path) -> PathBuf {
     fig7_variant(
         dir,
         "small_map.toml",
