@@ -36,11 +36,7 @@ fn figure_3_events(d: &Scene, n: usize) -> Result<Vec<crate::analysis::event::Ev
         stop_at: Vec::new(),
         polish: false,
     });
-    Ok(crate::study::run::run_scene(
-        &scene,
-        Some(n),
-        &mut crate::study::observer::equilibria(|_| Ok(())),
-    )?)
+    Ok(crate::study::run::run_scene(&scene, Some(n), &mut ())?)
 }
 
 /// The walls, crossing and branch point nearest the paper's values at

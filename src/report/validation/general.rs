@@ -346,15 +346,7 @@ fn strip_weight_table(scenes: &Path) -> Result<String> {
          sixth point of the branch and its last:\n",
         scene.model.segments
     )?;
-    let mut eqs = Vec::new();
-    let events = run_scene(
-        &scene,
-        None,
-        &mut crate::study::observer::equilibria(|e| {
-            eqs.push(e);
-            Ok(())
-        }),
-    )?;
+    let (eqs, events) = super::runs::run_collected(&scene)?;
     writeln!(
         s,
         "| w L³/B | n(0) | Tw | Lk | walled | stable | knot | good | self-distance |"

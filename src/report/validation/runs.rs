@@ -4,17 +4,22 @@ use crate::report::error::Result;
 use crate::scene::Scene;
 use std::path::Path;
 
-/// Runs a scene given as TOML text and returns its equilibria and events.
-pub(super) fn run_text(
-    text: &str,
-) -> Result<(
+/// A scene's equilibria and events.
+pub(super) type Run = (
     Vec<crate::analysis::equilibrium::Equilibrium>,
     Vec<crate::analysis::event::Event>,
-)> {
-    let scene = Scene::parse(text)?;
+);
+
+/// Runs a scene given as TOML text and returns its equilibria and events.
+pub(super) fn run_text(text: &str) -> Result<Run> {
+    run_collected(&Scene::parse(text)?)
+}
+
+/// Runs a scene and returns its equilibria and events.
+pub(super) fn run_collected(scene: &Scene) -> Result<Run> {
     let mut eqs = Vec::new();
     let events = crate::study::run::run_scene(
-        &scene,
+        scene,
         None,
         &mut crate::study::observer::equilibria(|e| {
             eqs.push(e);
