@@ -393,6 +393,8 @@ class EventKind(str, Enum):
     """The rod touches a wall (enters or leaves the walled region)."""
     CROSSING = "crossing"
     """The centreline passes through itself or a ray (the link jumps by ±2)."""
+    RIBBON_CONTACT = "ribbon_contact"
+    """A strip's ribbon comes to touch itself, or comes clear of itself."""
     STABILITY = "stability"
     """The count of negative eigenvalues changes."""
     FOLD = "fold"

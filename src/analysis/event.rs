@@ -14,6 +14,9 @@ pub enum EventKind {
     Wall,
     /// The centreline passes through itself or a ray (the link jumps by ±2).
     Crossing,
+    /// A strip's ribbon comes to touch itself, or comes clear of itself
+    /// (the crossing X of a ribbon, before its centreline's).
+    RibbonContact,
     /// The count of negative eigenvalues changes.
     Stability,
     /// The parameter turns back along the branch.
@@ -36,6 +39,7 @@ impl EventKind {
         match self {
             EventKind::Wall => "wall",
             EventKind::Crossing => "crossing",
+            EventKind::RibbonContact => "ribbon_contact",
             EventKind::Stability => "stability",
             EventKind::Fold => "fold",
             EventKind::BranchPoint => "branch_point",
@@ -47,9 +51,7 @@ impl EventKind {
     }
 
     /// The quantity that vanishes at an event of this kind (none for a jump,
-    /// an end or a lost contact, which no test function locates). A ribbon
-    /// touching itself is recorded as a crossing: its quantity is then the
-    /// ribbon's, [`Vanishing::RibbonGap`], told by the strip's width.
+    /// an end or a lost contact, which no test function locates).
     pub fn vanishing(self) -> Option<Vanishing> {
         match self {
             EventKind::Fold | EventKind::Stability | EventKind::BranchPoint => {
@@ -57,6 +59,7 @@ impl EventKind {
             }
             EventKind::Wall => Some(Vanishing::WallGap),
             EventKind::Crossing | EventKind::KnotChange => Some(Vanishing::StrandGap),
+            EventKind::RibbonContact => Some(Vanishing::RibbonGap),
             EventKind::Jump | EventKind::End | EventKind::ContactLost => None,
         }
     }
@@ -65,7 +68,7 @@ impl EventKind {
     fn label_prefix(self) -> Option<&'static str> {
         match self {
             EventKind::Wall => Some("W"),
-            EventKind::Crossing => Some("X"),
+            EventKind::Crossing | EventKind::RibbonContact => Some("X"),
             EventKind::BranchPoint => Some("S"),
             EventKind::Fold => Some("F"),
             EventKind::Jump => Some("J"),
@@ -124,8 +127,12 @@ pub struct Event {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(tag = "reason", rename_all = "snake_case")]
 pub enum PolishFailure {
-    /// Walls and crossings of a ribbon have no continuum test function.
+    /// Walls and crossings of a ribbon were not polished (written by
+    /// versions before the ribbon's continuum test functions; read only).
     Ribbon,
+    /// A merger of two critical points of a distance is not an event of a
+    /// branch.
+    Merger,
     /// The discrete centreline has no self-approach to start a crossing from.
     NoSelfApproach,
     /// The crossing is of a closing ray, not of the centreline's strands.
@@ -178,6 +185,7 @@ impl std::fmt::Display for PolishFailure {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             PolishFailure::Ribbon => write!(f, "walls and crossings of a ribbon are not polished"),
+            PolishFailure::Merger => write!(f, "a merger of critical points is not polished"),
             PolishFailure::NoSelfApproach => write!(f, "no self-approach of the centreline"),
             PolishFailure::RayCrossing { distance } => write!(
                 f,
@@ -256,7 +264,8 @@ impl Event {
 /// for crossings in the order met from the start of the branch.
 pub fn label_events(events: &mut [Event]) {
     let mut crossings = HashMap::<(usize, u64), usize>::new();
-    for e in events.iter_mut().filter(|e| e.kind == EventKind::Crossing) {
+    let crossing = |k: EventKind| matches!(k, EventKind::Crossing | EventKind::RibbonContact);
+    for e in events.iter_mut().filter(|e| crossing(e.kind)) {
         let k = crossings.entry((e.branch, e.z_star.to_bits())).or_insert(0);
         *k += 1;
         e.label = if *k == 1 { "X".into() } else { format!("X{k}") };

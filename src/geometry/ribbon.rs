@@ -191,6 +191,32 @@ impl Ribbon<'_> {
         best
     }
 
+    /// A pair of pieces at least `gap` apart in arc length that touch (their
+    /// distance is zero), other than the pairs `skip(i, j)` (i < j) leaves
+    /// out, if there is one.
+    pub fn touching_pair(
+        &self,
+        arc: &[f64],
+        gap: f64,
+        skip: &dyn Fn(usize, usize) -> bool,
+    ) -> Option<[usize; 2]> {
+        let tree = CurveTree::new(self.points);
+        let mut found = None;
+        let width = self.width;
+        let done = std::cell::Cell::new(false);
+        // pieces touch only where their centrelines come within w
+        tree.walk_pairs(arc, gap, &|d| done.get() || d > width, &mut |i, j| {
+            if found.is_none()
+                && !skip(i, j)
+                && piece_distance(&self.piece(i), &self.piece(j)).distance <= 0.0
+            {
+                found = Some([i, j]);
+                done.set(true);
+            }
+        });
+        found
+    }
+
     /// Brute-force O(N²) reference for [`Ribbon::min_self_distance`].
     pub fn min_self_distance_brute(&self, arc: &[f64], gap: f64) -> Option<Approach> {
         let mut best: Option<Approach> = None;

@@ -289,13 +289,6 @@ impl Scene {
                  for kind = \"strip\" or \"unbendable\"",
             ));
         }
-        if self.map.is_some() {
-            return Err(invalid(
-                "model.strip_width",
-                "a map's boundary walk follows the centreline's crossings and walls, not the \
-                 ribbon's: use strip_width = 0 with [map], or a [continuation]",
-            ));
-        }
         if self.contact.is_some() {
             return Err(invalid(
                 "model.strip_width",

@@ -429,7 +429,7 @@ impl<'a, 'r> BranchRun<'a, 'r> {
         } else {
             "the ribbon touches itself"
         };
-        self.record_located(EventKind::Crossing, &located, branch, detail.into());
+        self.record_located(EventKind::RibbonContact, &located, branch, detail.into());
         Ok(())
     }
 

@@ -226,6 +226,7 @@ fn boundary_label(
                 e.kind,
                 EventKind::Wall
                     | EventKind::Crossing
+                    | EventKind::RibbonContact
                     | EventKind::BranchPoint
                     | EventKind::Fold
                     | EventKind::Stability
@@ -239,7 +240,7 @@ fn boundary_label(
             let label = match (e.kind, lower) {
                 (EventKind::Wall, true) => "W1",
                 (EventKind::Wall, false) => "W2",
-                (EventKind::Crossing, _) => "X",
+                (EventKind::Crossing | EventKind::RibbonContact, _) => "X",
                 (EventKind::Fold, _) => "F",
                 _ => "S",
             };

@@ -240,15 +240,18 @@ fn test_function(
     match c {
         Vanishing::Singularity => singular_at(branch, z),
         Vanishing::WallGap => {
-            // the interior node nearest a wall
+            // the interior node nearest a wall (of a ribbon: its lowest or
+            // highest point across the width there)
             let (points, arc) = state.centreline();
             let (origin, axis) = (state.clamps.start_point(), state.clamps.start_tangent());
             let top = state.clamps.top_wall();
             let n = state.segments();
+            let half = 0.5 * measure.strip_width;
             let (mut best, mut on_top, mut s) = (f64::INFINITY, false, 0.5);
             for i in 1..=n.min(points.len() - 2) {
                 let h = (points[i] - origin).dot(&axis);
-                for (w, t) in [(0.0, false), (top, true)] {
+                let reach = half * state.directors(i.min(n - 1))[0].dot(&axis).abs();
+                for (w, t, h) in [(0.0, false, h - reach), (top, true, h + reach)] {
                     if (h - w).abs() < best {
                         (best, on_top, s) = ((h - w).abs(), t, arc[i]);
                     }
@@ -257,7 +260,12 @@ fn test_function(
             Ok(TestFunction::Wall { top: on_top, s })
         }
         Vanishing::StrandGap => {
-            let approach = self_approach(state, measure)
+            // the centrelines' crossing, also of a ribbon (its knot changes)
+            let centreline = Measure {
+                strip_width: 0.0,
+                ..measure.clone()
+            };
+            let approach = self_approach(state, &centreline)
                 .ok_or(PolishError::Event(PolishFailure::NoSelfApproach))?;
             // a strand passing through a ray, not through the centreline
             if approach.distance > 2.0 / state.segments() as f64 {
@@ -267,11 +275,15 @@ fn test_function(
             }
             Ok(TestFunction::Crossing { s: approach.s })
         }
-        // no event kind carries these on a centreline (polish_one turns
-        // a ribbon's events away first)
-        Vanishing::RibbonGap | Vanishing::StrandMerger => {
-            Err(PolishError::Event(PolishFailure::Ribbon))
+        Vanishing::RibbonGap => {
+            // the ribbon's pieces touch: sought from the centrelines'
+            // closest points across from where they do
+            let approach = self_approach(state, measure)
+                .ok_or(PolishError::Event(PolishFailure::NoSelfApproach))?;
+            Ok(TestFunction::RibbonCrossing { s: approach.s })
         }
+        // no event kind carries a merger of critical points
+        Vanishing::StrandMerger => Err(PolishError::Event(PolishFailure::Merger)),
     }
 }
 
@@ -284,10 +296,8 @@ fn polish_one(
     c: Vanishing,
     fold: bool,
 ) -> Result<ContinuumEvent, PolishError> {
-    if measure.strip_width > 0.0 && c != Vanishing::Singularity {
-        return Err(PolishError::Event(PolishFailure::Ribbon));
-    }
-    let branch = ContinuumBranch::new(model, state.clamps, parameter, POLISH_TOLERANCE)?;
+    let branch = ContinuumBranch::new(model, state.clamps, parameter, POLISH_TOLERANCE)?
+        .on_ribbon(measure.strip_width);
     let discrete = parameter.value(&state.clamps);
     let mut z = BranchPoint::zeros();
     z.fixed_rows_mut::<6>(0)
@@ -313,7 +323,9 @@ fn polish_one(
     let arclengths = match &fine.test {
         TestFunction::Wall { s, .. } => vec![*s],
         TestFunction::Walls => vec![],
-        TestFunction::Crossing { s } | TestFunction::Merging { s } => s.to_vec(),
+        TestFunction::Crossing { s }
+        | TestFunction::RibbonCrossing { s }
+        | TestFunction::Merging { s } => s.to_vec(),
         TestFunction::Singular { .. } => vec![],
     };
     Ok(ContinuumEvent {

@@ -10,7 +10,11 @@
 //! its special points): folds and branch points where the shooting Jacobian
 //! is singular (a bordered determinant), walls where an interior extremum of
 //! the height touches a wall, crossings where the signed distance of two
-//! strands vanishes.
+//! strands vanishes. A strip of finite width is measured on its ribbon, the
+//! surface r + v d1 for |v| ≤ w/2 ([`ContinuumBranch::on_ribbon`]): its
+//! heights reach ±(w/2)|d1·e| past the centreline's, and two strands of it
+//! first touch where an edge r ± (w/2) d1 of one crosses an edge of the
+//! other ([`TestFunction::RibbonCrossing`]).
 
 use crate::model::rod::{Clamps, Parameter, RodModel};
 use crate::solve::continuum::{Continuum, ContinuumError, Frame, Unknowns};
@@ -30,6 +34,9 @@ const CORRECTOR_ITERATIONS: usize = 30;
 const NOISE_PROBE: f64 = 1e-2;
 /// Secant steps before giving up.
 const SECANT_ITERATIONS: usize = 40;
+/// How far (in arclength, along each strand) the closest points of two
+/// edges of a ribbon may lie from the centrelines' (at least 4 w).
+const EDGE_REACH: f64 = 0.05;
 
 /// Why the continuum branch or an event on it could not be computed.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -51,6 +58,9 @@ pub enum BranchError {
     NoRoot(String),
 }
 
+/// Arclengths, and the lowest and highest heights across the section there.
+pub type HeightRange = (Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// The family of continuum problems along one parameter.
 #[derive(Clone, Debug)]
 pub struct ContinuumBranch<'a> {
@@ -59,6 +69,9 @@ pub struct ContinuumBranch<'a> {
     parameter: Parameter,
     /// Tolerance of the adaptive integrator.
     pub tolerance: f64,
+    /// Width w/L of the ribbon on which walls are measured (0: the
+    /// centreline).
+    ribbon: f64,
 }
 
 /// A test function of the continuum branch: a [`Vanishing`] quantity with
@@ -96,6 +109,16 @@ pub enum TestFunction {
         /// Arclengths of the two closest points (updated as they move).
         s: [f64; 2],
     },
+    /// Two strands of the ribbon touch: the least of the signed distances
+    /// of their four pairs of edges r ± (w/2) d1, each oriented as the
+    /// centrelines' signed distance (positive while the ribbons are apart),
+    /// sought near the centrelines' closest points at arclengths `s`. Two
+    /// narrow ribbons crossing at an angle first touch edge to edge (the
+    /// corner of their overlap), so this is their exact first touch.
+    RibbonCrossing {
+        /// Arclengths of the centrelines' closest points (updated).
+        s: [f64; 2],
+    },
     /// The closest points of two strands near arclengths `s` merge with
     /// another critical point of their distance (a pitchfork or fold of the
     /// closest approach: where two crossings of the same strands run into
@@ -115,6 +138,7 @@ impl TestFunction {
             TestFunction::Singular { .. } => Vanishing::Singularity,
             TestFunction::Wall { .. } | TestFunction::Walls => Vanishing::WallGap,
             TestFunction::Crossing { .. } => Vanishing::StrandGap,
+            TestFunction::RibbonCrossing { .. } => Vanishing::RibbonGap,
             TestFunction::Merging { .. } => Vanishing::StrandMerger,
         }
     }
@@ -152,7 +176,17 @@ impl<'a> ContinuumBranch<'a> {
             clamps,
             parameter,
             tolerance,
+            ribbon: 0.0,
         })
+    }
+
+    /// The same branch with its walls measured on the ribbon of width
+    /// `width` (w/L, along d1) instead of the centreline.
+    pub fn on_ribbon(self, width: f64) -> Self {
+        ContinuumBranch {
+            ribbon: width,
+            ..self
+        }
     }
 
     /// The same branch at another tolerance.
@@ -369,7 +403,7 @@ impl<'a> ContinuumBranch<'a> {
                 Ok((test.clone(), bordered_determinant(&j, left, right)?))
             }
             TestFunction::Wall { top, s } => {
-                let (s, h) = self.extremum(z, *s)?;
+                let (s, h) = self.extremum(z, *s, *top)?;
                 // the top wall moves with z* along a branch in z*
                 let wall = if *top {
                     self.clamps_at(z[PARAMETER]).top_wall()
@@ -383,6 +417,10 @@ impl<'a> ContinuumBranch<'a> {
                 let (s, d, _) = self.closest_strands(z, *s)?;
                 Ok((TestFunction::Crossing { s }, d))
             }
+            TestFunction::RibbonCrossing { s } => {
+                let (s, gap) = self.ribbon_gap(z, *s)?;
+                Ok((TestFunction::RibbonCrossing { s }, gap))
+            }
             TestFunction::Merging { s } => {
                 let (s, _, det) = self.closest_strands(z, *s)?;
                 Ok((TestFunction::Merging { s }, det))
@@ -393,23 +431,40 @@ impl<'a> ContinuumBranch<'a> {
     /// The height of the solution at z at 199 interior points of the
     /// centreline (s = k/200): the arclengths and the heights.
     pub fn heights(&self, z: &BranchPoint) -> Result<(Vec<f64>, Vec<f64>), BranchError> {
+        let (stops, low, _) = self.height_range(z)?;
+        Ok((stops, low))
+    }
+
+    /// The lowest and highest heights across the section (the ribbon's
+    /// edges, or the centreline's when it has no width) at the 199 interior
+    /// points s = k/200: the arclengths, the lowest and the highest.
+    pub fn height_range(&self, z: &BranchPoint) -> Result<HeightRange, BranchError> {
         const SAMPLES: usize = 200;
         let stops: Vec<f64> = (1..SAMPLES).map(|k| k as f64 / SAMPLES as f64).collect();
         let frames = self.frames_at(z, &stops)?;
-        let h = frames.iter().map(|f| self.height(z, &f.r)).collect();
-        Ok((stops, h))
+        let axis = self.clamps_at(z[PARAMETER]).start_tangent();
+        let (low, high) = frames
+            .iter()
+            .map(|f| {
+                let h = self.height(z, &f.r);
+                let reach = 0.5 * self.ribbon * f.d1.dot(&axis).abs();
+                (h - reach, h + reach)
+            })
+            .unzip();
+        Ok((stops, low, high))
     }
 
     /// The smaller of the lowest interior extremum's height and the top
     /// wall minus the highest one's: the centreline sampled at 200 points,
     /// the local extremum nearest a wall refined by Newton.
     fn wall_gap(&self, z: &BranchPoint) -> Result<f64, BranchError> {
-        let (stops, h) = self.heights(z)?;
+        let (stops, low, high) = self.height_range(z)?;
         let top = self.clamps_at(z[PARAMETER]).top_wall();
         // local minima against the bottom wall, maxima against the top
         let mut best: Option<(f64, usize, bool)> = None;
-        for i in 1..h.len() - 1 {
-            for (upper, gap) in [(false, h[i]), (true, top - h[i])] {
+        for i in 1..low.len() - 1 {
+            for (upper, gap) in [(false, low[i]), (true, top - high[i])] {
+                let h = if upper { &high } else { &low };
                 let sign = if upper { -1.0 } else { 1.0 };
                 let extremal = sign * (h[i] - h[i - 1]) <= 0.0 && sign * (h[i] - h[i + 1]) <= 0.0;
                 if extremal && best.is_none_or(|b| gap < b.0) {
@@ -419,13 +474,17 @@ impl<'a> ContinuumBranch<'a> {
         }
         let (_, i, upper) =
             best.ok_or_else(|| BranchError::NoRoot("no interior extremum of the height".into()))?;
-        let (_, height) = self.extremum(z, stops[i])?;
+        let (_, height) = self.extremum(z, stops[i], upper)?;
         Ok(if upper { top - height } else { height })
     }
 
     /// The interior extremum of the height nearest arclength `s0`: Newton
-    /// on h'(s) = d3·e = 0 with h''(s) = d3'·e from the frame equations.
-    fn extremum(&self, z: &BranchPoint, s0: f64) -> Result<(f64, f64), BranchError> {
+    /// on h'(s) = d3·e = 0 with h''(s) = d3'·e from the frame equations. On
+    /// a ribbon, the extremum of its highest (`upper`) or lowest edge.
+    fn extremum(&self, z: &BranchPoint, s0: f64, upper: bool) -> Result<(f64, f64), BranchError> {
+        if self.ribbon > 0.0 {
+            return self.edge_extremum(z, s0, upper);
+        }
         let axis = self.clamps_at(z[PARAMETER]).start_tangent();
         let mut s = s0;
         for _ in 0..30 {
@@ -445,6 +504,153 @@ impl<'a> ContinuumBranch<'a> {
         Err(BranchError::NoRoot(format!(
             "no interior extremum of the height near s = {s0:.4}"
         )))
+    }
+
+    /// The extremum nearest `s0` of the ribbon's height across its width,
+    /// f(s) = h(s) ± (w/2)|d1·e| (+ for the highest edge, `upper`): Newton on
+    /// f'(s) = d3·e ± (w/2) sgn(d1·e) d1'·e, its slope f'' by central
+    /// differences. f is smooth at its extrema (|d1·e| only kinks where the
+    /// ribbon is level across, a maximum of the lowest edge, never a minimum).
+    fn edge_extremum(
+        &self,
+        z: &BranchPoint,
+        s0: f64,
+        upper: bool,
+    ) -> Result<(f64, f64), BranchError> {
+        let axis = self.clamps_at(z[PARAMETER]).start_tangent();
+        let sign = if upper { 1.0 } else { -1.0 };
+        let half = 0.5 * self.ribbon;
+        let value = |f: &Frame| self.height(z, &f.r) + sign * half * f.d1.dot(&axis).abs();
+        let slope = |f: &Frame| {
+            let across = f.d1.dot(&axis);
+            f.d3.dot(&axis) + sign * half * across.signum() * f.d1_rate.dot(&axis)
+        };
+        const DS: f64 = 1e-5;
+        let mut s = s0;
+        for _ in 0..30 {
+            let lo = (s - DS).max(1e-6);
+            let hi = (s + DS).min(1.0 - 1e-6);
+            let f = self.frames_at(z, &[lo, s, hi])?;
+            let curvature = (slope(&f[2]) - slope(&f[0])) / (hi - lo);
+            if curvature == 0.0 || !curvature.is_finite() {
+                break;
+            }
+            let step = -slope(&f[1]) / curvature;
+            s = (s + step).clamp(1e-6, 1.0 - 1e-6);
+            if step.abs() < 1e-12 {
+                let f = self.frames_at(z, &[s])?[0];
+                return Ok((s, value(&f)));
+            }
+        }
+        Err(BranchError::NoRoot(format!(
+            "no interior extremum of the ribbon's height near s = {s0:.4}"
+        )))
+    }
+
+    /// The ribbon's gap at two strands whose centrelines are closest near
+    /// arclengths `s0`: the least over the four pairs of edges r ± (w/2) d1
+    /// of their signed distance (along the edges' tangents' cross product),
+    /// each turned positive on the side where the centrelines are apart.
+    /// Each pair's closest points are found by Newton from the centrelines'
+    /// (the edges' second derivatives by central differences); a pair with
+    /// no closest approach within [`EDGE_REACH`] of the centrelines' (the
+    /// edges turn away from each other there) cannot touch there and is
+    /// left out.
+    fn ribbon_gap(&self, z: &BranchPoint, s0: [f64; 2]) -> Result<([f64; 2], f64), BranchError> {
+        let (s, centre, _) = self.closest_strands(z, s0)?;
+        let side = centre.signum();
+        let mut gap = f64::INFINITY;
+        for signs in [[1.0, 1.0], [1.0, -1.0], [-1.0, 1.0], [-1.0, -1.0]] {
+            if let Some(signed) = self.edge_distance(z, s, signs)? {
+                gap = gap.min(side * signed);
+            }
+        }
+        if gap == f64::INFINITY {
+            return Err(BranchError::NoRoot(format!(
+                "no closest approach of the ribbon's edges near s = {:.4}, {:.4}",
+                s[0], s[1]
+            )));
+        }
+        Ok((s, gap))
+    }
+
+    /// The signed distance of edges `signs` (±1 each: r ± (w/2) d1) of two
+    /// strands at their closest points near arclengths `s0`, along the
+    /// cross product of their tangents; None if they have no closest
+    /// approach (a minimum of their distance) within [`EDGE_REACH`].
+    fn edge_distance(
+        &self,
+        z: &BranchPoint,
+        s0: [f64; 2],
+        signs: [f64; 2],
+    ) -> Result<Option<f64>, BranchError> {
+        const DS: f64 = 1e-5;
+        let half = 0.5 * self.ribbon;
+        let tangent = |f: &Frame, sign: f64| f.d3 + sign * half * f.d1_rate;
+        // position, tangent and rate of change of the tangent of one edge
+        let edge = |s: f64, sign: f64| -> Result<_, BranchError> {
+            let (lo, hi) = ((s - DS).max(0.0), (s + DS).min(1.0));
+            let f = self.frames_at(z, &[lo, s, hi])?;
+            let rate = (tangent(&f[2], sign) - tangent(&f[0], sign)) / (hi - lo);
+            Ok((f[1].r + sign * half * f[1].d1, tangent(&f[1], sign), rate))
+        };
+        let reach = EDGE_REACH.max(4.0 * self.ribbon);
+        let mut t = s0;
+        // a strand's end: its edge ends at the corner of the clamped end, and
+        // the closest point stays there (a corner against an edge)
+        let mut at_end = [false; 2];
+        for _ in 0..60 {
+            let (ca, ta, ra) = edge(t[0], signs[0])?;
+            let (cb, tb, rb) = edge(t[1], signs[1])?;
+            let d = ca - cb;
+            let g = nalgebra::Vector2::new(d.dot(&ta), -d.dot(&tb));
+            let jac = nalgebra::Matrix2::new(
+                ta.dot(&ta) + d.dot(&ra),
+                -tb.dot(&ta),
+                -ta.dot(&tb),
+                tb.dot(&tb) - d.dot(&rb),
+            );
+            let step = match at_end {
+                [false, false] => {
+                    // a saddle or a maximum of the distance: no closest
+                    // approach
+                    if jac.determinant() <= 0.0 || jac[(0, 0)] <= 0.0 {
+                        return Ok(None);
+                    }
+                    let Some(step) = jac.lu().solve(&(-g)) else {
+                        return Ok(None);
+                    };
+                    step
+                }
+                [true, true] => nalgebra::Vector2::zeros(),
+                _ => {
+                    let k = usize::from(at_end[0]);
+                    if jac[(k, k)] <= 0.0 {
+                        return Ok(None);
+                    }
+                    let mut step = nalgebra::Vector2::zeros();
+                    step[k] = -g[k] / jac[(k, k)];
+                    step
+                }
+            };
+            // stationary (where two closest approaches merge, at a crossing
+            // on the flip axis, Newton crawls, but the distance is flat)
+            let free_gradient = (0..2).filter(|&k| !at_end[k]).map(|k| g[k].abs());
+            if step.norm() < 1e-12 || free_gradient.fold(0.0, f64::max) < 1e-12 {
+                return Ok(signed_along(&d, &ta, &tb));
+            }
+            for k in 0..2 {
+                t[k] += step[k];
+                if !(0.0..=1.0).contains(&t[k]) {
+                    t[k] = t[k].clamp(0.0, 1.0);
+                    at_end[k] = true;
+                }
+            }
+            if (t[0] - s0[0]).abs().max((t[1] - s0[1]).abs()) > reach {
+                return Ok(None);
+            }
+        }
+        Ok(None)
     }
 
     /// The frame at s and d3'(s).
@@ -572,6 +778,12 @@ impl<'a> ContinuumBranch<'a> {
             "secant steps in coordinate {held} did not converge (last values {ga:.3e}, {gb:.3e})"
         )))
     }
+}
+
+/// The component of `d` along ta × tb (None for parallel tangents).
+fn signed_along(d: &Vector3<f64>, ta: &Vector3<f64>, tb: &Vector3<f64>) -> Option<f64> {
+    let normal = ta.cross(tb);
+    (normal.norm() >= 1e-8).then(|| d.dot(&normal) / normal.norm())
 }
 
 /// Index of the smallest singular value.

@@ -154,6 +154,8 @@ pub struct Frame {
     pub d3: Vector3<f64>,
     /// d3'(s) = r''(s).
     pub curvature: Vector3<f64>,
+    /// d1'(s): how the ribbon's edges r ± (w/2) d1 turn.
+    pub d1_rate: Vector3<f64>,
 }
 
 fn part<const D: usize>(y: &SVector<f64, D>, k: usize) -> Vector3<f64> {
@@ -306,6 +308,7 @@ impl Continuum {
             d2: Vector3::from_column_slice(&y[6..9]),
             d3: Vector3::from_column_slice(&y[9..12]),
             curvature: Vector3::from_column_slice(&dy[9..12]),
+            d1_rate: Vector3::from_column_slice(&dy[3..6]),
         };
         Ok(match self.law {
             ContinuumLaw::Kirchhoff { k2, k3 } => {

@@ -79,11 +79,94 @@ pub(super) fn strand_distance(
         OtherStrand::BottomRay => (points[0], points[0] - reach * Vector3::z()),
         OtherStrand::TopRay => (last, last + reach * Vector3::z()),
     };
-    let (d, ta, tb) = segment_distance(&a0, &a1, &b0, &b1);
+    signed_segments(&a0, &a1, &b0, &b1)
+}
+
+/// Distance of two segments and their signed distance along the cross
+/// product of their directions.
+fn signed_segments(
+    a0: &Vector3<f64>,
+    a1: &Vector3<f64>,
+    b0: &Vector3<f64>,
+    b1: &Vector3<f64>,
+) -> (f64, f64) {
+    let (d, ta, tb) = segment_distance(a0, a1, b0, b1);
     let pa = a0 + ta * (a1 - a0);
     let pb = b0 + tb * (b1 - b0);
     let n = (a1 - a0).cross(&(b1 - b0));
     (d, (pb - pa).dot(&n) / n.norm().max(1e-300))
+}
+
+/// A strip's ribbon's two edges as the walk follows them: the polylines
+/// pₖ ± (w/2) nₖ through the centreline's points, nₖ the mean of the
+/// directors d1 of the segments meeting at point k. Unlike the edges of the
+/// pieces ([`crate::geometry::ribbon`]), which jump where d1 turns from one
+/// segment to the next, they are continuous, so their distances are too;
+/// both tend to the continuum ribbon's edges r ± (w/2) d1.
+#[derive(Clone, Debug)]
+pub(super) struct Edges {
+    /// The director across at each centreline point.
+    across: Vec<Vector3<f64>>,
+    /// Half the width.
+    half: f64,
+}
+
+impl Edges {
+    /// The edges of the ribbon of width `width` whose segment k carries the
+    /// director `d1[k]`.
+    pub(super) fn new(d1: &[Vector3<f64>], width: f64) -> Edges {
+        let last = d1.len() - 1;
+        let across = (0..=d1.len())
+            .map(|k| (d1[k.saturating_sub(1)] + d1[k.min(last)]).normalize())
+            .collect();
+        Edges {
+            across,
+            half: 0.5 * width,
+        }
+    }
+
+    /// Edge `sign` (±1) along segment k.
+    fn edge(&self, points: &[Vector3<f64>], k: usize, sign: f64) -> [Vector3<f64>; 2] {
+        let a = sign * self.half;
+        [
+            points[k] + a * self.across[k],
+            points[k + 1] + a * self.across[k + 1],
+        ]
+    }
+
+    /// The ribbon's gap at two strands whose centrelines cross near segments
+    /// i and j: the least over the four pairs of edges of their signed
+    /// distance (each pair's closest segments within `window` of i and j),
+    /// times `sign`. Two narrow ribbons crossing at an angle first touch
+    /// edge to edge, so it vanishes where the ribbon first touches itself
+    /// there.
+    pub(super) fn gap(
+        &self,
+        points: &[Vector3<f64>],
+        i: usize,
+        j: usize,
+        window: usize,
+        sign: f64,
+    ) -> f64 {
+        let segments = points.len() - 1;
+        let near = |k: usize| k.saturating_sub(window)..(k + window + 1).min(segments);
+        let mut gap = f64::INFINITY;
+        for (sa, sb) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            let mut best = (f64::INFINITY, 0.0);
+            for a in near(i) {
+                let [a0, a1] = self.edge(points, a, sa);
+                for b in near(j).filter(|&b| b >= a + 2) {
+                    let [b0, b1] = self.edge(points, b, sb);
+                    let (d, signed) = signed_segments(&a0, &a1, &b0, &b1);
+                    if d < best.0 {
+                        best = (d, signed);
+                    }
+                }
+            }
+            gap = gap.min(sign * best.1);
+        }
+        gap
+    }
 }
 
 impl Strands {
@@ -93,7 +176,12 @@ impl Strands {
     /// crossings are one boundary.
     pub(super) fn near(&self, first: usize, other: OtherStrand) -> bool {
         // strands crossing at a shallow angle are close over several pairs
-        let close = |x: usize, y: usize| x.abs_diff(y) <= 3;
+        self.near_within(first, other, 3)
+    }
+
+    /// As [`Strands::near`], within `window` segments along each.
+    pub(super) fn near_within(&self, first: usize, other: OtherStrand, window: usize) -> bool {
+        let close = |x: usize, y: usize| x.abs_diff(y) <= window;
         let same = |a: usize, oa: OtherStrand, b: usize, ob: OtherStrand| {
             close(a, b)
                 && match (oa, ob) {
@@ -115,13 +203,14 @@ impl Strands {
 /// The strands nearest to passing through each other: the closest pair of
 /// segments at least `gap` apart in arc length, or a segment and a ray,
 /// other than the strands `except` (the crossings the walk is on or tried
-/// already at this corner, in contact
-/// at a corner between two crossings).
+/// already at this corner, in contact at a corner between two crossings);
+/// pairs of segments only unless `rays`.
 pub(super) fn closest_strands(
     points: &[Vector3<f64>],
     arc: &[f64],
     gap: f64,
     except: &[Strands],
+    rays: bool,
 ) -> (usize, OtherStrand) {
     let reach = crate::geometry::closure::reach(points);
     let segments = points.len() - 1;
@@ -136,7 +225,8 @@ pub(super) fn closest_strands(
                 }
             }
         }
-        for (ray, base) in [(OtherStrand::BottomRay, 0.0), (OtherStrand::TopRay, 1.0)] {
+        let ends = [(OtherStrand::BottomRay, 0.0), (OtherStrand::TopRay, 1.0)];
+        for (ray, base) in ends.into_iter().filter(|_| rays) {
             let mid = 0.5 * (arc[i] + arc[i + 1]);
             if (mid - base).abs() >= gap && !skip(i, ray) {
                 let d = strand_distance(points, i, ray, reach).0;
@@ -168,6 +258,36 @@ mod tests {
         let (_, down) = strand_distance(&at(-0.2), 0, OtherStrand::Segment(2), 10.0);
         assert!((d - 0.3).abs() < 1e-12 && (up - 0.3).abs() < 1e-12);
         assert!((down + 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_ribbon_s_gap_is_the_centrelines_less_the_pieces_reach_across() {
+        // strand a along x at height 0, strand b along y at height h; the
+        // ribbons' d1 tilted by 30° out of their planes: each reaches
+        // (w/2) sin 30° towards the other, so the edges meet at h = w/2
+        let (w, tilt) = (0.2, 30f64.to_radians());
+        let at = |h: f64| {
+            let points = vec![
+                Vector3::new(-1.0, 0.0, 0.0),
+                Vector3::new(0.0, 0.0, 0.0),
+                Vector3::new(1.0, 0.0, 0.0),
+                Vector3::new(0.0, -1.0, h),
+                Vector3::new(0.0, 0.0, h),
+                Vector3::new(0.0, 1.0, h),
+            ];
+            let across_a = Vector3::new(0.0, tilt.cos(), tilt.sin());
+            let across_b = Vector3::new(tilt.cos(), 0.0, tilt.sin());
+            let d1 = vec![across_a, across_a, across_a, across_b, across_b];
+            let edges = Edges::new(&d1, w);
+            // the crossing is at points 1 and 4, whose directors are their
+            // strands' own (the joining segment's mixes in at points 2, 3)
+            edges.gap(&points, 0, 3, 1, 1.0)
+        };
+        for h in [0.3, 0.1, 0.05] {
+            // sign: t_a × t_b = x × y = z, so b above a is positive
+            let expected = h - 0.5 * w * 2.0 * tilt.sin();
+            assert!((at(h) - expected).abs() < 1e-12, "{h}: {}", at(h));
+        }
     }
 
     #[test]

@@ -50,6 +50,9 @@ struct Plane<'a> {
     /// The walk's largest step: how far apart the points may lie, and about
     /// how far the polish may move one.
     spacing: f64,
+    /// Width of the ribbon the walls and crossings are measured on (0: the
+    /// centreline).
+    ribbon: f64,
 }
 
 /// The free coordinate of a line crossing a curve of unit normal `normal`:
@@ -70,12 +73,10 @@ impl Plane<'_> {
         free: usize,
         tolerance: f64,
     ) -> Result<ContinuumBranch<'_>, PolishError> {
-        Ok(ContinuumBranch::new(
-            self.model,
-            self.clamps(at),
-            self.params[free],
-            tolerance,
-        )?)
+        Ok(
+            ContinuumBranch::new(self.model, self.clamps(at), self.params[free], tolerance)?
+                .on_ribbon(self.ribbon),
+        )
     }
 
     /// The continuum test function of condition `c` at the discrete `state`
@@ -107,11 +108,14 @@ impl Plane<'_> {
                     &points[j],
                     &points[j + 1],
                 );
-                Ok(TestFunction::Crossing {
-                    s: [
-                        arc[i] + ta * (arc[i + 1] - arc[i]),
-                        arc[j] + tb * (arc[j + 1] - arc[j]),
-                    ],
+                let s = [
+                    arc[i] + ta * (arc[i + 1] - arc[i]),
+                    arc[j] + tb * (arc[j + 1] - arc[j]),
+                ];
+                Ok(if self.ribbon > 0.0 {
+                    TestFunction::RibbonCrossing { s }
+                } else {
+                    TestFunction::Crossing { s }
                 })
             }
         }
@@ -505,11 +509,11 @@ const CORNER_ITERATIONS: usize = 42;
 const STALLED_ITERATES: usize = 4;
 
 /// The continuum solution at z lies between the walls (to `slack`, touching
-/// allowed), at the points of [`ContinuumBranch::heights`].
+/// allowed), at the points of [`ContinuumBranch::height_range`].
 fn walled(branch: &ContinuumBranch, z: &BranchPoint, slack: f64) -> Result<bool, PolishError> {
-    let (_, heights) = branch.heights(z)?;
+    let (_, low, high) = branch.height_range(z)?;
     let top = branch.clamps_at(z[PARAMETER]).top_wall();
-    Ok(heights.iter().all(|&h| h >= -slack && h <= top + slack))
+    Ok(low.iter().all(|&h| h >= -slack) && high.iter().all(|&h| h <= top + slack))
 }
 
 /// How far outside the walls a boundary point's continuum solution may
@@ -528,7 +532,7 @@ fn apart(a: &[f64; 2], b: &[f64; 2]) -> f64 {
 /// The closest points of a crossing's test.
 fn crossing_points(t: &TestFunction) -> Option<[f64; 2]> {
     match t {
-        TestFunction::Crossing { s } => Some(*s),
+        TestFunction::Crossing { s } | TestFunction::RibbonCrossing { s } => Some(*s),
         _ => None,
     }
 }
@@ -617,6 +621,7 @@ pub(super) fn polish_boundary(
     base: Clamps,
     trail: &[Trail],
     spacing: f64,
+    ribbon: f64,
 ) -> Result<PolishedBoundary, PolishError> {
     if trail.is_empty() {
         return Err(PolishError::NoBoundary);
@@ -626,6 +631,7 @@ pub(super) fn polish_boundary(
         params,
         base,
         spacing,
+        ribbon,
     };
     let (jobs, points, dropped) = plane.walk_points(trail)?;
     let piece_of = pieces_by_critical_point(trail.len(), &jobs, &points);

@@ -2,8 +2,9 @@
 //! pseudo-arclength continuation in the plane, corners where another property
 //! fails, equilibria by Newton at fixed clamps.
 
-use crate::analysis::equilibrium::Measure;
+use crate::analysis::equilibrium::{Measure, walls};
 use crate::geometry::closure::closure_knot_along;
+use crate::geometry::ribbon::Ribbon;
 use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::scene::MapSpec;
 use crate::scene::Scene;
@@ -11,7 +12,7 @@ use crate::solve::continuation::{Point, Tracer};
 use crate::solve::event::Vanishing;
 use crate::solve::step::{Acceptance, StepControl, Trial};
 use crate::study::boundary::condition::{
-    Condition, OtherStrand, Strands, closest_strands, strand_distance,
+    Condition, Edges, OtherStrand, Strands, closest_strands, strand_distance,
 };
 use crate::study::boundary::polish::polish_boundary;
 use crate::study::boundary::traced::{Traced, Trail, TrailPoint, merge_crossings, name_pieces};
@@ -68,6 +69,13 @@ struct Walk<'t, 'a> {
     bounds: [[f64; 2]; 2],
     max_step: f64,
     equilibria: usize,
+}
+
+/// Director d1 of each centreline segment of `state` (the clamps' included).
+fn directors(state: &RodState) -> Vec<nalgebra::Vector3<f64>> {
+    (0..state.centreline().0.len() - 1)
+        .map(|k| state.directors(k)[0])
+        .collect()
 }
 
 /// A parameter in messages: φ as the paper writes it, others by their name.
@@ -151,8 +159,8 @@ impl Walk<'_, '_> {
         let state = &site.point.state;
         Ok(match c {
             Condition::Wall => {
-                let (lo, hi) = state.z_range();
-                lo.min(state.clamps.top_wall() - hi)
+                let w = walls(state, self.measure.strip_width);
+                w.min_z.min(state.clamps.top_wall() - w.max_z)
             }
             Condition::Crossing(s) => {
                 let (points, _) = state.centreline();
@@ -177,7 +185,17 @@ impl Walk<'_, '_> {
                 }
                 s.first = best.2;
                 s.other = best.3;
-                s.sign * best.1
+                match s.other {
+                    // a strip's ribbon touches itself before its centreline
+                    // crosses (a ray, the closure's, has no width)
+                    OtherStrand::Segment(j) if self.measure.strip_width > 0.0 => {
+                        let edges = Edges::new(&directors(state), self.measure.strip_width);
+                        let width = self.measure.strip_width * segments as f64;
+                        let window = 3 + width.ceil() as usize;
+                        edges.gap(&points, s.first, j, window, s.sign)
+                    }
+                    _ => s.sign * best.1,
+                }
             }
             Condition::Stability => {
                 let energy = &self.tracer.newton.energy;
@@ -235,25 +253,55 @@ impl Walk<'_, '_> {
     ) -> Result<Option<Vanishing>> {
         let skip = on.map(Condition::vanishing);
         let state = &site.point.state;
-        let (lo, hi) = state.z_range();
-        if skip != Some(Vanishing::WallGap) && (lo <= 0.0 || hi >= state.clamps.top_wall()) {
+        let w = walls(state, self.measure.strip_width);
+        if skip != Some(Vanishing::WallGap)
+            && (w.min_z <= 0.0 || w.max_z >= state.clamps.top_wall())
+        {
             return Ok(Some(Vanishing::WallGap));
         }
         if skip != Some(Vanishing::Singularity) && site.point.negative_count > 0 {
             return Ok(Some(Vanishing::Singularity));
         }
         let good = self.measure.good.clone();
-        let trefoil = |s: &RodState| {
+        let (width, gap) = (self.measure.strip_width, self.measure.self_distance_gap);
+        // on a crossing of the ribbon, its own pieces (and their flip
+        // image's) may still touch at their corners a step into the good
+        // side, where the edges the walk follows are apart: they are left
+        // out of the check
+        let followed = match on {
+            Some(Condition::Crossing(s)) => Some(*s),
+            _ => None,
+        };
+        // a ribbon touches itself before its centreline crosses: so that
+        // boundary first (see `condition_of`)
+        let passage = |s: &RodState| {
+            let touching = width > 0.0 && {
+                let (points, arc) = s.centreline();
+                let d1 = directors(s);
+                let window = 3 + (width * (points.len() - 1) as f64).ceil() as usize;
+                let skip = |i: usize, j: usize| {
+                    followed.is_some_and(|f| f.near_within(i, OtherStrand::Segment(j), window))
+                };
+                let ribbon = Ribbon {
+                    points: &points,
+                    d1: &d1,
+                    width,
+                };
+                ribbon.touching_pair(&arc, gap, &skip).is_some()
+            };
+            if touching {
+                return Some(Vanishing::RibbonGap);
+            }
             let knot = closure_knot_along(&s.centreline().0, s.ray_directions()).ok();
-            good.is_knot(knot.as_ref().map(|k| k.alexander.as_slice()))
+            let knotted = good.is_knot(knot.as_ref().map(|k| k.alexander.as_slice()));
+            (!knotted).then_some(Vanishing::StrandGap)
         };
-        let knotted = if skip == Some(Vanishing::StrandGap) {
+        if skip == Some(Vanishing::StrandGap) {
             let off = self.equilibrium_at(site, along(site.p, normal, FD))?;
-            trefoil(&off.point.state)
+            Ok(passage(&off.point.state))
         } else {
-            trefoil(state)
-        };
-        Ok((!knotted).then_some(Vanishing::StrandGap))
+            Ok(passage(state))
+        }
     }
 
     /// The condition behind a failure at the site `bad`, just past a corner
@@ -264,12 +312,14 @@ impl Walk<'_, '_> {
         match failure {
             Vanishing::WallGap => Condition::Wall,
             Vanishing::Singularity => Condition::Stability,
-            // `failing` tells only walls, stability and the knot apart (maps
-            // of ribbons are refused), so the rest is the knot's crossing
+            // `failing` tells walls, stability, the ribbon's touch and the
+            // knot apart: the rest is a crossing (of the ribbon, whose
+            // pieces touch, between segments only)
             Vanishing::StrandGap | Vanishing::RibbonGap | Vanishing::StrandMerger => {
                 let (points, arc) = bad.point.state.centreline();
-                let (first, other) =
-                    closest_strands(&points, &arc, self.measure.self_distance_gap, except);
+                let rays = failure != Vanishing::RibbonGap;
+                let gap = self.measure.self_distance_gap;
+                let (first, other) = closest_strands(&points, &arc, gap, except, rays);
                 Condition::Crossing(Strands {
                     first,
                     other,
@@ -459,6 +509,7 @@ pub fn trace_island(
             base,
             &pieces,
             spec.trace_step,
+            walk.measure.strip_width,
         )
     });
     let mut traced = name_pieces([swept, along], walk.equilibria, pieces, closed, stopped);
