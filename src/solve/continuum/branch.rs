@@ -35,7 +35,7 @@ const NOISE_PROBE: f64 = 1e-2;
 /// Secant steps before giving up.
 const SECANT_ITERATIONS: usize = 40;
 /// How far (in arclength, along each strand) the closest points of two
-/// edges of a ribbon may lie from the centrelines' (at least 4 w).
+/// edges of a ribbon may lie from the centrelines' (at least 2 w).
 const EDGE_REACH: f64 = 0.05;
 
 /// Why the continuum branch or an event on it could not be computed.
@@ -594,12 +594,13 @@ impl<'a> ContinuumBranch<'a> {
             let rate = (tangent(&f[2], sign) - tangent(&f[0], sign)) / (hi - lo);
             Ok((f[1].r + sign * half * f[1].d1, tangent(&f[1], sign), rate))
         };
-        let reach = EDGE_REACH.max(4.0 * self.ribbon);
+        const MOVE: f64 = 0.01;
+        let reach = EDGE_REACH.max(2.0 * self.ribbon);
         let mut t = s0;
         // a strand's end: its edge ends at the corner of the clamped end, and
         // the closest point stays there (a corner against an edge)
         let mut at_end = [false; 2];
-        for _ in 0..60 {
+        for _ in 0..100 {
             let (ca, ta, ra) = edge(t[0], signs[0])?;
             let (cb, tb, rb) = edge(t[1], signs[1])?;
             let d = ca - cb;
@@ -610,29 +611,32 @@ impl<'a> ContinuumBranch<'a> {
                 -ta.dot(&tb),
                 tb.dot(&tb) - d.dot(&rb),
             );
-            let step = match at_end {
+            let mut step = match at_end {
                 [false, false] => {
-                    // a saddle or a maximum of the distance: no closest
-                    // approach
-                    if jac.determinant() <= 0.0 || jac[(0, 0)] <= 0.0 {
-                        return Ok(None);
-                    }
-                    let Some(step) = jac.lu().solve(&(-g)) else {
-                        return Ok(None);
-                    };
-                    step
+                    // away from a closest approach (the distance's Hessian
+                    // not positive) a descent step
+                    let newton = (jac.determinant() > 0.0 && jac[(0, 0)] > 0.0)
+                        .then(|| jac.lu().solve(&(-g)))
+                        .flatten();
+                    newton.unwrap_or(-g)
                 }
                 [true, true] => nalgebra::Vector2::zeros(),
                 _ => {
                     let k = usize::from(at_end[0]);
-                    if jac[(k, k)] <= 0.0 {
-                        return Ok(None);
-                    }
                     let mut step = nalgebra::Vector2::zeros();
-                    step[k] = -g[k] / jac[(k, k)];
+                    step[k] = if jac[(k, k)] > 0.0 {
+                        -g[k] / jac[(k, k)]
+                    } else {
+                        -g[k]
+                    };
                     step
                 }
             };
+            // steps no longer than MOVE: where the edges cross at a shallow
+            // angle the first Newton steps overshoot
+            if step.norm() > MOVE {
+                step *= MOVE / step.norm();
+            }
             // stationary (where two closest approaches merge, at a crossing
             // on the flip axis, Newton crawls, but the distance is flat)
             let free_gradient = (0..2).filter(|&k| !at_end[k]).map(|k| g[k].abs());
