@@ -31,6 +31,7 @@ pub fn map(
         );
     }
     scene.check_budget(Job::Map, segments, allow_large)?;
+    let scene = crate::cli::run::lab_scene(scene, segments)?;
     let spec = scene
         .map
         .clone()

@@ -44,6 +44,7 @@ pub fn run(
         );
     }
     scene.check_budget(Job::Run, segments, allow_large)?;
+    let scene = lab_scene(scene, segments)?;
     let model = scene.rod_model(segments);
     let start = std::time::Instant::now();
     let json = json.or(scene.output.json.clone());
@@ -326,4 +327,22 @@ fn report(
         writeln!(out, "plot written to {}", f.display())?;
     }
     Ok(())
+}
+
+/// The scene with gravity fixed in the lab (`[load] major_loop`), the
+/// direction found printed.
+pub(crate) fn lab_scene(scene: Scene, segments: Option<usize>) -> Result<Scene> {
+    let Some(facing) = scene.load.major_loop else {
+        return Ok(scene);
+    };
+    let lab = crate::study::start::in_the_lab(&scene, segments)?.into_owned();
+    let g = lab.load.direction;
+    eprintln!(
+        "gravity across the clamps' axis, the major loop facing {}: along ({:.4}, {:.4}, {:.4})",
+        facing.name(),
+        g[0],
+        g[1],
+        g[2]
+    );
+    Ok(lab)
 }

@@ -1,26 +1,32 @@
-//! A strip of finite width as a ribbon: each segment of the centreline
-//! carries a rectangle of width w along its material director d1, centred on
-//! the segment (from −w/2 to +w/2 along d1). Distances between parts of the
-//! ribbon and its heights (for the walls) are measured on these rectangles,
-//! not on the centreline.
+//! A strip of finite width as a ribbon: the surface swept by a segment of
+//! width w across the centreline along its material director d1 (from −w/2
+//! to +w/2). At each point of the centreline the ribbon runs across along
+//! the mean of the directors d1 of the two segments meeting there, so each
+//! segment carries a quadrilateral piece between its two ends' crossbars and
+//! the ribbon is continuous (its edges do not jump where d1 turns from one
+//! segment to the next), tending to the continuum's r ± (w/2) d1. Distances
+//! between parts of the ribbon and its heights (for the walls) are measured
+//! on these pieces, not on the centreline.
 //!
-//! A rectangle is two of parry's triangles; the distance of two rectangles
-//! is exact: zero when an edge of one pierces the other (parry's
-//! ray–triangle test), else the least of the corner-to-rectangle projections
-//! (parry's triangle point projection) and the edge–edge closest points —
-//! the closest points of two disjoint convex polygons always include a
-//! corner or a pair of edges.
+//! A piece is two of parry's triangles; the distance of two pieces is
+//! exact: zero when an edge of one (its diagonal included) pierces the
+//! other (parry's ray–triangle test), else the least of the corner-to-piece
+//! projections (parry's triangle point projection) and the edge–edge
+//! closest points — the closest points of two disjoint triangles always
+//! include a corner or a pair of edges.
 
 use crate::geometry::distance::{Approach, CurveTree, segment_distance, v};
 use nalgebra::Vector3;
 use parry3d_f64::query::{PointQuery, Ray, RayCast};
 use parry3d_f64::shape::Triangle;
 
-/// The rectangle of one ribbon segment: corners p0 − a, p0 + a, p1 + a,
-/// p1 − a with a = (w/2) d1.
+/// The piece of one ribbon segment: corners p0 − a0, p0 + a0, p1 + a1,
+/// p1 − a1 with a0, a1 its ends' crossbars ((w/2) d1 for a rectangle), as
+/// the two triangles either side of the diagonal from the first corner to
+/// the third.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Piece {
-    /// Corners in order round the rectangle.
+    /// Corners in order round the piece.
     pub corners: [Vector3<f64>; 4],
 }
 
@@ -39,9 +45,22 @@ impl Piece {
     /// The piece of the segment p0 → p1 with director `d1` (a unit vector
     /// normal to the segment) and full width `width`.
     pub fn new(p0: &Vector3<f64>, p1: &Vector3<f64>, d1: &Vector3<f64>, width: f64) -> Piece {
-        let a = 0.5 * width * d1;
+        Piece::between(p0, p1, d1, d1, width)
+    }
+
+    /// The piece of the segment p0 → p1 whose ends run across along `a0`
+    /// and `a1` (unit vectors), of full width `width`: a quadrilateral, as
+    /// two triangles.
+    pub fn between(
+        p0: &Vector3<f64>,
+        p1: &Vector3<f64>,
+        a0: &Vector3<f64>,
+        a1: &Vector3<f64>,
+        width: f64,
+    ) -> Piece {
+        let (a0, a1) = (0.5 * width * a0, 0.5 * width * a1);
         Piece {
-            corners: [p0 - a, p0 + a, p1 + a, p1 - a],
+            corners: [p0 - a0, p0 + a0, p1 + a1, p1 - a1],
         }
     }
 
@@ -53,9 +72,17 @@ impl Piece {
         ]
     }
 
-    fn edges(&self) -> [(Vector3<f64>, Vector3<f64>); 4] {
+    /// The triangles' edges: the four round the piece and the diagonal
+    /// (where a piece that is not flat may be met or be closest).
+    fn edges(&self) -> [(Vector3<f64>, Vector3<f64>); 5] {
         let c = &self.corners;
-        [(c[0], c[1]), (c[1], c[2]), (c[2], c[3]), (c[3], c[0])]
+        [
+            (c[0], c[1]),
+            (c[1], c[2]),
+            (c[2], c[3]),
+            (c[3], c[0]),
+            (c[0], c[2]),
+        ]
     }
 
     /// The nearest point of the piece to `p`.
@@ -142,12 +169,22 @@ pub struct Ribbon<'a> {
 }
 
 impl Ribbon<'_> {
-    /// The rectangle of segment k.
+    /// The direction the ribbon runs across at point k: the mean of the
+    /// directors of the segments meeting there (the end segments' own at
+    /// the ends).
+    pub fn across(&self, k: usize) -> Vector3<f64> {
+        let last = self.d1.len() - 1;
+        let (before, after) = (self.d1[k.saturating_sub(1).min(last)], self.d1[k.min(last)]);
+        (before + after).try_normalize(1e-12).unwrap_or(after)
+    }
+
+    /// The piece of segment k, between the crossbars at its two points.
     pub fn piece(&self, k: usize) -> Piece {
-        Piece::new(
+        Piece::between(
             &self.points[k],
             &self.points[k + 1],
-            &self.d1[k],
+            &self.across(k),
+            &self.across(k + 1),
             self.width,
         )
     }
@@ -235,18 +272,15 @@ impl Ribbon<'_> {
     }
 
     /// The lowest and highest heights (z) of the ribbon across each point:
-    /// point k is a corner of the pieces of segments k − 1 and k, whose
-    /// corners there lie ±(w/2)|d1_z| above and below it.
+    /// its crossbar there reaches ±(w/2)|a_z| above and below it (a the
+    /// direction across, [`Ribbon::across`]).
     pub fn heights(&self) -> (Vec<f64>, Vec<f64>) {
-        let last = self.d1.len() - 1;
         let half = 0.5 * self.width;
         self.points
             .iter()
             .enumerate()
             .map(|(k, p)| {
-                let before = self.d1[k.saturating_sub(1).min(last)].z.abs();
-                let after = self.d1[k.min(last)].z.abs();
-                let reach = half * before.max(after);
+                let reach = half * self.across(k).z.abs();
                 (p.z - reach, p.z + reach)
             })
             .unzip()
@@ -333,6 +367,10 @@ mod tests {
         };
         let (low, high) = ribbon.heights();
         assert_eq!(low[0], 0.0);
-        assert!((low[1] + 0.2 * s).abs() < 1e-15 && (high[2] - 1.0 - 0.2 * s).abs() < 1e-15);
+        // across at point 1: the mean of y and (0, s, s), 22.5° out of the
+        // plane; at the last point, its segment's own
+        let mid = std::f64::consts::FRAC_PI_8.sin();
+        assert!((low[1] + 0.2 * mid).abs() < 1e-15, "{}", low[1]);
+        assert!((high[2] - 1.0 - 0.2 * s).abs() < 1e-15);
     }
 }

@@ -631,6 +631,33 @@ pub struct LoadSpec {
     /// The direction of gravity (normalised; default −e3).
     #[serde(default = "default_gravity", deserialize_with = "exact::array")]
     pub direction: [f64; 3],
+    /// Gravity across the clamps' axis, along or against the direction of
+    /// the knot's major loop in the weightless start (the lab's strips
+    /// facing "down" or "up", paper Sec. 5), fixed from then on: replaces
+    /// `direction` once the start is known (`study::start::in_the_lab`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub major_loop: Option<LoopFacing>,
+}
+
+/// Which way a knot's major loop points in the lab.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum LoopFacing {
+    /// The major loop points downwards: gravity along its direction (the
+    /// paper's photographed knot).
+    Down,
+    /// The major loop points upwards: gravity against its direction.
+    Up,
+}
+
+impl LoopFacing {
+    /// The name used in scenes.
+    pub fn name(self) -> &'static str {
+        match self {
+            LoopFacing::Down => "down",
+            LoopFacing::Up => "up",
+        }
+    }
 }
 
 impl Default for LoadSpec {
@@ -638,6 +665,7 @@ impl Default for LoadSpec {
         LoadSpec {
             weight: 0.0,
             direction: default_gravity(),
+            major_loop: None,
         }
     }
 }

@@ -7,12 +7,13 @@ use crate::model::energy::{RodEnergy, Terms};
 use crate::model::rod::{Clamps, Law, RodModel, RodState};
 use crate::model::shooting::ShootingSolution;
 use crate::model::strip_shooting::{StripProblem, StripUnknowns};
-use crate::scene::{InitialShape, InitialSpec, Scene, SceneError};
+use crate::scene::{InitialShape, InitialSpec, LoopFacing, Scene, SceneError};
 use crate::solve::continuum::shooting::refine_shooting_loaded;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolveReport;
 use crate::study::error::{Context, Result, fail};
 use nalgebra::Vector3;
+use std::borrow::Cow;
 
 /// The initial state a scene asks for, at N segments.
 pub fn initial_state(scene: &Scene, model: &RodModel) -> Result<RodState> {
@@ -223,6 +224,8 @@ pub fn starting_equilibrium(
     scene: &Scene,
     segments: Option<usize>,
 ) -> Result<(Minimizer, RodState, SolveReport)> {
+    let lab = in_the_lab(scene, segments)?;
+    let scene = &*lab;
     let (model, mut newton) = minimizer(scene, segments);
     if scene.initial.shape == InitialShape::DoubleRing {
         // unfold the double ring quasi-statically: straight from its own
@@ -274,6 +277,56 @@ pub fn starting_equilibrium(
         .minimize(&mut state, &scene.solver)
         .context("Newton minimisation")?;
     Ok((newton, state, report))
+}
+
+/// The scene with its gravity fixed in the lab: where `[load] major_loop`
+/// asks for gravity along (down) or against (up) the knot's major loop, its
+/// direction is measured once on the weightless start at the scene's
+/// clamps ([`major_loop_direction`]) and written into `load.direction`, so
+/// that it stays fixed while the clamps move (the lab's gravity does not
+/// turn with the knot). Any other scene is returned as it is.
+pub fn in_the_lab(scene: &Scene, segments: Option<usize>) -> Result<Cow<'_, Scene>> {
+    let Some(facing) = scene.load.major_loop else {
+        return Ok(Cow::Borrowed(scene));
+    };
+    let mut weightless = scene.clone();
+    weightless.load.weight = 0.0;
+    weightless.load.major_loop = None;
+    let (_, state, _) = starting_equilibrium(&weightless, segments)
+        .context("the weightless start, whose major loop gives gravity's direction")?;
+    let Some(u) = major_loop_direction(&state) else {
+        fail!(
+            "load.major_loop: the weightless start's centreline has its centroid on the \
+             clamps' axis, so no major loop points anywhere (use load.direction)"
+        );
+    };
+    let g = match facing {
+        LoopFacing::Down => u,
+        LoopFacing::Up => -u,
+    };
+    let mut lab = scene.clone();
+    lab.load.direction = g.into();
+    lab.load.major_loop = None;
+    Ok(Cow::Owned(lab))
+}
+
+/// The direction of a knot's major loop: the unit vector from the clamps'
+/// axis (the line through the two clamps' points) to the centroid of the
+/// centreline, normal to the axis; None where the centroid lies on it.
+pub fn major_loop_direction(state: &RodState) -> Option<Vector3<f64>> {
+    let (points, _) = state.centreline();
+    let (mut sum, mut length) = (Vector3::zeros(), 0.0);
+    for w in points.windows(2) {
+        let l = (w[1] - w[0]).norm();
+        sum += 0.5 * l * (w[0] + w[1]);
+        length += l;
+    }
+    let centroid = sum / length;
+    let (a, b) = (state.start_point(), state.end_point());
+    let axis = (b - a).try_normalize(1e-12).unwrap_or_else(Vector3::z);
+    let off = centroid - a;
+    let across = off - off.dot(&axis) * axis;
+    across.try_normalize(1e-9 * length)
 }
 
 /// The scene field a start shape comes from.

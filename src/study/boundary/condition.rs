@@ -98,11 +98,10 @@ fn signed_segments(
 }
 
 /// A strip's ribbon's two edges as the walk follows them: the polylines
-/// pₖ ± (w/2) nₖ through the centreline's points, nₖ the mean of the
-/// directors d1 of the segments meeting at point k. Unlike the edges of the
-/// pieces ([`crate::geometry::ribbon`]), which jump where d1 turns from one
-/// segment to the next, they are continuous, so their distances are too;
-/// both tend to the continuum ribbon's edges r ± (w/2) d1.
+/// pₖ ± (w/2) aₖ through the centreline's points, aₖ the direction the
+/// ribbon runs across there ([`crate::geometry::ribbon::Ribbon::across`]),
+/// the long edges of its pieces: continuous, so their distances are too,
+/// and tending to the continuum ribbon's edges r ± (w/2) d1.
 #[derive(Clone, Debug)]
 pub(super) struct Edges {
     /// The director across at each centreline point.
@@ -114,11 +113,9 @@ pub(super) struct Edges {
 impl Edges {
     /// The edges of the ribbon of width `width` whose segment k carries the
     /// director `d1[k]`.
-    pub(super) fn new(d1: &[Vector3<f64>], width: f64) -> Edges {
-        let last = d1.len() - 1;
-        let across = (0..=d1.len())
-            .map(|k| (d1[k.saturating_sub(1)] + d1[k.min(last)]).normalize())
-            .collect();
+    pub(super) fn new(points: &[Vector3<f64>], d1: &[Vector3<f64>], width: f64) -> Edges {
+        let ribbon = crate::geometry::ribbon::Ribbon { points, d1, width };
+        let across = (0..=d1.len()).map(|k| ribbon.across(k)).collect();
         Edges {
             across,
             half: 0.5 * width,
@@ -278,7 +275,7 @@ mod tests {
             let across_a = Vector3::new(0.0, tilt.cos(), tilt.sin());
             let across_b = Vector3::new(tilt.cos(), 0.0, tilt.sin());
             let d1 = vec![across_a, across_a, across_a, across_b, across_b];
-            let edges = Edges::new(&d1, w);
+            let edges = Edges::new(&points, &d1, w);
             // the crossing is at points 1 and 4, whose directors are their
             // strands' own (the joining segment's mixes in at points 2, 3)
             edges.gap(&points, 0, 3, 1, 1.0)

@@ -78,6 +78,12 @@ fn directors(state: &RodState) -> Vec<nalgebra::Vector3<f64>> {
         .collect()
 }
 
+/// How many segments along each strand a ribbon's touch may lie from the
+/// centrelines' closest points: 3, and the ribbon's width in segments.
+fn ribbon_window(width: f64, segments: usize) -> usize {
+    3 + (width * segments as f64).ceil() as usize
+}
+
 /// A parameter in messages: φ as the paper writes it, others by their name.
 fn label(p: Parameter) -> &'static str {
     if p == Parameter::Phi {
@@ -189,9 +195,9 @@ impl Walk<'_, '_> {
                     // a strip's ribbon touches itself before its centreline
                     // crosses (a ray, the closure's, has no width)
                     OtherStrand::Segment(j) if self.measure.strip_width > 0.0 => {
-                        let edges = Edges::new(&directors(state), self.measure.strip_width);
-                        let width = self.measure.strip_width * segments as f64;
-                        let window = 3 + width.ceil() as usize;
+                        let d1 = directors(state);
+                        let edges = Edges::new(&points, &d1, self.measure.strip_width);
+                        let window = ribbon_window(self.measure.strip_width, segments);
                         edges.gap(&points, s.first, j, window, s.sign)
                     }
                     _ => s.sign * best.1,
@@ -278,7 +284,7 @@ impl Walk<'_, '_> {
             let touching = width > 0.0 && {
                 let (points, arc) = s.centreline();
                 let d1 = directors(s);
-                let window = 3 + (width * (points.len() - 1) as f64).ceil() as usize;
+                let window = ribbon_window(width, points.len() - 1);
                 let skip = |i: usize, j: usize| {
                     followed.is_some_and(|f| f.near_within(i, OtherStrand::Segment(j), window))
                 };
@@ -317,9 +323,15 @@ impl Walk<'_, '_> {
             // pieces touch, between segments only)
             Vanishing::StrandGap | Vanishing::RibbonGap | Vanishing::StrandMerger => {
                 let (points, arc) = bad.point.state.centreline();
-                let rays = failure != Vanishing::RibbonGap;
                 let gap = self.measure.self_distance_gap;
-                let (first, other) = closest_strands(&points, &arc, gap, except, rays);
+                // a ribbon's: the pieces that touch (not always across the
+                // centreline's closest pair, where the ribbon is flat)
+                let touching = (failure == Vanishing::RibbonGap)
+                    .then(|| self.touching_strands(&bad.point.state, except))
+                    .flatten();
+                let rays = failure != Vanishing::RibbonGap;
+                let (first, other) =
+                    touching.unwrap_or_else(|| closest_strands(&points, &arc, gap, except, rays));
                 Condition::Crossing(Strands {
                     first,
                     other,
@@ -328,6 +340,31 @@ impl Walk<'_, '_> {
                 })
             }
         }
+    }
+
+    /// Two pieces of the ribbon of `state` that touch, other than those
+    /// near the strands `except` (and their flip image).
+    fn touching_strands(
+        &self,
+        state: &RodState,
+        except: &[Strands],
+    ) -> Option<(usize, OtherStrand)> {
+        let width = self.measure.strip_width;
+        let (points, arc) = state.centreline();
+        let d1 = directors(state);
+        let window = ribbon_window(width, points.len() - 1);
+        let skip = |i: usize, j: usize| {
+            except
+                .iter()
+                .any(|e| e.near_within(i, OtherStrand::Segment(j), window))
+        };
+        let ribbon = Ribbon {
+            points: &points,
+            d1: &d1,
+            width,
+        };
+        let [i, j] = ribbon.touching_pair(&arc, self.measure.self_distance_gap, &skip)?;
+        Some((i, OtherStrand::Segment(j)))
     }
 
     /// Orient a crossing positive on the good side: its sign at `reference`,
