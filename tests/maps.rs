@@ -325,3 +325,64 @@ fn polished_strip_island_is_the_same_from_two_walks() {
         "X1/X2 at φ/2π {continuum}, the walk's {discrete}"
     );
 }
+
+/// Several maps on one plane (Figure 10-right's style): the first's island
+/// as a region, the others' as curves, each named, a knot marked; a map
+/// without a closed boundary, a file that is no map, and names that do not
+/// match the maps are refused.
+#[test]
+fn several_maps_are_drawn_on_one_plane() {
+    let dir = temp_dir("overlay");
+    let scene = fig7_variant(
+        &dir,
+        "traced.toml",
+        &[
+            ("segments = 100", "segments = 40"),
+            ("lines = 27", "lines = 3"),
+            ("grid_columns = 91", "grid_columns = 11"),
+            ("polish = true", "polish = false"),
+        ],
+    );
+    let s = scene.to_str().unwrap();
+    let traced = dir.join("traced.json");
+    knotrod_ok(&["map", s, "--json", traced.to_str().unwrap()]);
+    let open = small_map_scene(&dir);
+    let untraced = dir.join("untraced.json");
+    knotrod_ok(&[
+        "map",
+        open.to_str().unwrap(),
+        "--json",
+        untraced.to_str().unwrap(),
+    ]);
+    let t = traced.to_str().unwrap();
+    let over = dir.join("over");
+    knotrod_ok(&[
+        "plot",
+        t,
+        t,
+        "--name",
+        "the region",
+        "--name",
+        "the curve",
+        "--mark",
+        "a knot=0.15,0.8",
+        "--out",
+        over.to_str().unwrap(),
+    ]);
+    let svg = std::fs::read_to_string(over.with_extension("svg")).unwrap();
+    for text in ["the region", "the curve", "a knot"] {
+        assert!(svg.contains(text), "{text} not in the overlay");
+    }
+    let refused = |args: &[&str], why: &str| {
+        let e = knotrod(args);
+        let err = String::from_utf8_lossy(&e.stderr);
+        assert!(!e.status.success() && err.contains(why), "{args:?}: {err}");
+    };
+    let o = over.to_str().unwrap();
+    refused(
+        &["plot", t, untraced.to_str().unwrap(), "--out", o],
+        "no closed boundary",
+    );
+    refused(&["plot", t, s, "--out", o], "map files");
+    refused(&["plot", t, t, "--name", "one", "--out", o], "--name");
+}

@@ -41,3 +41,19 @@ for name in fig7_island_kirchhoff fig7_island_strip; do
     cp "$T/$name.png" "$F/${name}_n100.png"
     echo "map written to $F/${name}_n100.png"
 done
+
+# Figure 10-right: the four islands at δ = 0.10 on one plane (zero width as
+# the region; the lab's ribbon, and that ribbon under its weight facing down
+# and up, as curves) and the photographed knot
+for name in fig10_island fig10_island_ribbon fig10_island_down fig10_island_up; do
+    "$K" map scenes/$name.toml --json "$T/$name.map.json" >/dev/null 2>&1
+done
+"$K" plot "$T/fig10_island.map.json" "$T/fig10_island_ribbon.map.json" \
+    "$T/fig10_island_down.map.json" "$T/fig10_island_up.map.json" \
+    --name "(a) w = 0" --name "(b) ribbon w/L = 0.057" \
+    --name "(c) ribbon, weight 25, loop down" --name "(d) ribbon, weight 25, loop up" \
+    --mark "photographed knot=0.17,0.78" \
+    --title "Figure 10-right: the strip's island at δ = 0.10 (N = 100, polished)" \
+    --out "$T/fig10" >/dev/null
+cp "$T/fig10.png" "$F/fig10_islands.png"
+echo "map written to $F/fig10_islands.png"

@@ -119,11 +119,24 @@ pub enum Command {
     /// Redraw the bifurcation diagram of a run's JSON summary or MCAP recording.
     Plot {
         /// The summary (`run --json`), recording (`.mcap`) or map file
-        /// (`map --json`).
-        summary: PathBuf,
-        /// Output stem (default: the summary's path without extension).
+        /// (`map --json`); several map files are drawn on one plane, the
+        /// first's island as a region, the others' as curves.
+        #[arg(required = true)]
+        summary: Vec<PathBuf>,
+        /// Output stem (default: the first file's path without extension).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Several maps: the name of each in the legend, once per map in
+        /// order (default: their scenes').
+        #[arg(long = "name")]
+        names: Vec<String>,
+        /// Several maps: a point to mark, NAME=SWEPT,ALONG (e.g. "photographed
+        /// knot=0.17,0.78" for z*, φ/2π).
+        #[arg(long)]
+        mark: Option<String>,
+        /// Several maps: the title.
+        #[arg(long)]
+        title: Option<String>,
     },
     /// Map the good-knot region: a branch in the continuation's parameter (φ for the
     /// paper's maps) per value of the map's parameter.
@@ -251,7 +264,16 @@ pub fn main_with(cli: Cli) -> Result<()> {
             rays,
             json,
         } => knot::knot(&curve, closed, rays, json),
-        Command::Plot { summary, out } => plot::plot(&summary, out),
+        Command::Plot {
+            summary,
+            out,
+            names,
+            mark,
+            title,
+        } => match summary.as_slice() {
+            [one] => plot::plot(one, out),
+            many => plot::overlay(many, out, &names, mark.as_deref(), title.as_deref()),
+        },
         Command::Map {
             scene,
             json,

@@ -35,6 +35,59 @@ pub fn plot(summary: &Path, out: Option<PathBuf>) -> Result<()> {
     Ok(())
 }
 
+/// Draw several map files' islands on one plane (see
+/// [`crate::io::plot::island_overlay`]) to `out` (default: the first
+/// file's path without extension).
+pub fn overlay(
+    files: &[PathBuf],
+    out: Option<PathBuf>,
+    names: &[String],
+    mark: Option<&str>,
+    title: Option<&str>,
+) -> Result<()> {
+    anyhow::ensure!(
+        names.is_empty() || names.len() == files.len(),
+        "--name: {} names for {} maps",
+        names.len(),
+        files.len()
+    );
+    let maps = files
+        .iter()
+        .map(|f| {
+            let text = crate::io::read_text(f, crate::io::DATA_FILE_LIMIT)
+                .with_context(|| format!("cannot read {}", f.display()))?;
+            serde_json::from_str::<Map>(&text).with_context(|| {
+                format!(
+                    "{}: several files are drawn together only as map files (`map --json`)",
+                    f.display()
+                )
+            })
+        })
+        .collect::<Result<Vec<Map>>>()?;
+    let named: Vec<(&str, &Map)> = maps
+        .iter()
+        .enumerate()
+        .map(|(k, m)| (names.get(k).map_or(m.scene.as_str(), |n| n.as_str()), m))
+        .collect();
+    let mark = match mark {
+        Some(m) => {
+            let parse = || -> Option<(&str, [f64; 2])> {
+                let (name, at) = m.split_once('=')?;
+                let (a, b) = at.split_once(',')?;
+                Some((name, [a.trim().parse().ok()?, b.trim().parse().ok()?]))
+            };
+            Some(parse().with_context(|| format!("--mark {m:?}: expected NAME=SWEPT,ALONG"))?)
+        }
+        None => None,
+    };
+    let stem = out.unwrap_or_else(|| files[0].with_extension(""));
+    let title = title.unwrap_or("good knots");
+    for f in crate::io::plot::island_overlay(&stem, title, &named, mark)? {
+        writeln!(std::io::stdout().lock(), "plot written to {}", f.display())?;
+    }
+    Ok(())
+}
+
 /// Title, points and events of a recording.
 fn from_recording(path: &Path) -> Result<(String, Vec<PlotPoint>, Vec<Event>)> {
     let rec = crate::io::recording::read_recording(path)?;

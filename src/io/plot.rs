@@ -851,6 +851,163 @@ where
     Ok(())
 }
 
+/// Several maps' islands on one plane, as the paper's Figure 10-right draws
+/// them: the first map's polished boundary (else its traced one) as a
+/// coloured region, the others' as curves, each named in the legend by its
+/// `names` entry; `mark`, if given, a point drawn and named (a knot of
+/// interest). SVG, and PNG when a font is available.
+pub fn island_overlay(
+    stem: &Path,
+    title: &str,
+    maps: &[(&str, &crate::study::map::Map)],
+    mark: Option<(&str, [f64; 2])>,
+) -> Result<Vec<std::path::PathBuf>> {
+    let mut written = Vec::new();
+    // the legend's layout measures its text: with the font registered
+    let fonts = font_available();
+    let svg = stem.with_extension("svg");
+    write_svg(&svg, (900, 700), |root| {
+        draw_overlay(root, title, maps, mark)
+    })?;
+    written.push(svg);
+    if fonts {
+        let png = stem.with_extension("png");
+        write_png(&png, (900, 700), |root| {
+            draw_overlay(root, title, maps, mark)
+        })?;
+        written.push(png);
+    }
+    Ok(written)
+}
+
+/// A map's island boundary, closed, as (value along, swept) points: the
+/// polished one, else the traced one; None without a closed one.
+fn island_outline(map: &crate::study::map::Map) -> Option<Vec<(f64, f64)>> {
+    let t = map.traced.as_ref().filter(|t| t.closed)?;
+    let mut pts: Vec<(f64, f64)> = match &t.polished {
+        Some(p) => p
+            .pieces
+            .iter()
+            .flat_map(|q| q.points.iter().map(|p| (p[1], p[0])))
+            .collect(),
+        None => t.polygon().iter().map(|p| (p[1], p[0])).collect(),
+    };
+    if let Some(&first) = pts.first() {
+        pts.push(first);
+    }
+    (pts.len() > 2).then_some(pts)
+}
+
+/// Colours of the overlaid curves after the region (distinct on white).
+const CURVES: [RGBColor; 4] = [
+    RGBColor(20, 20, 20),
+    RGBColor(200, 40, 40),
+    RGBColor(30, 80, 200),
+    RGBColor(150, 90, 0),
+];
+
+fn draw_overlay<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    maps: &[(&str, &crate::study::map::Map)],
+    mark: Option<(&str, [f64; 2])>,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
+    root.fill(&WHITE).map_err(err)?;
+    let outlines = maps
+        .iter()
+        .map(|(name, m)| {
+            let why = || {
+                let walk = m.traced.as_ref().and_then(|t| t.stopped.clone());
+                IoError::Plot(format!(
+                    "{name}: the map has no closed boundary to draw ({})",
+                    walk.unwrap_or_else(|| "no boundary traced".into())
+                ))
+            };
+            island_outline(m).map(|o| (*name, o)).ok_or_else(why)
+        })
+        .collect::<Result<Vec<(&str, Vec<(f64, f64)>)>>>()?;
+    let mut xs: Vec<f64> = outlines
+        .iter()
+        .flat_map(|o| o.1.iter().map(|p| p.0))
+        .collect();
+    let mut ys: Vec<f64> = outlines
+        .iter()
+        .flat_map(|o| o.1.iter().map(|p| p.1))
+        .collect();
+    if let Some((_, p)) = mark {
+        xs.push(p[1]);
+        ys.push(p[0]);
+    }
+    if xs.is_empty() {
+        return Err(IoError::Plot("no map has a traced boundary to draw".into()));
+    }
+    let (x0, x1) = bounds(&xs);
+    let (y0, y1) = bounds(&ys);
+    let (along, swept) = (maps[0].1.along, maps[0].1.parameter);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(12)
+        .margin_right(20)
+        .x_label_area_size(38)
+        .y_label_area_size(62)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(along.symbol())
+        .y_desc(swept.symbol())
+        .x_label_formatter(&|v| tick_text(*v))
+        .y_label_formatter(&|v| tick_text(*v))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(err)?;
+    let region = colour_of(Class::Good);
+    for (k, (name, pts)) in outlines.iter().enumerate() {
+        if k == 0 {
+            chart
+                .draw_series(std::iter::once(Polygon::new(pts.clone(), region.mix(0.45))))
+                .map_err(err)?
+                .label(*name)
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 6), (x + 20, y + 6)], region.mix(0.45).filled())
+                });
+        } else {
+            let c = CURVES[(k - 1) % CURVES.len()];
+            chart
+                .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
+                .map_err(err)?
+                .label(*name)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
+        }
+    }
+    if let Some((name, p)) = mark {
+        chart
+            .draw_series(std::iter::once(Cross::new(
+                (p[1], p[0]),
+                7,
+                BLACK.stroke_width(2),
+            )))
+            .map_err(err)?
+            .label(name)
+            .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.4))
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

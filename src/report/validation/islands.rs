@@ -59,7 +59,7 @@ fn island_table(scenes: &Path, name: &str, paper: &[&str]) -> Result<String> {
 
 /// The map as `knotrod map` computes it: the grid of lines and the traced
 /// boundary.
-fn island_map(
+pub(super) fn island_map(
     scene: &Scene,
     spec: &MapSpec,
     name: &str,

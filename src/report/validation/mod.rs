@@ -9,6 +9,7 @@ mod asymptotics;
 mod contact;
 mod convergence;
 mod double_ring;
+mod figure10;
 mod figure3;
 mod figure9;
 mod format;
@@ -49,6 +50,7 @@ pub fn report(scenes: &Path) -> Result<String> {
     s += &strip::section(scenes)?;
     s += &islands::strip_section(scenes)?;
     s += &figure9::section(scenes)?;
+    s += &figure10::section(scenes)?;
     s += &double_ring::section()?;
     s += &asymptotics::section()?;
     s += &contact::section(scenes)?;

@@ -1,0 +1,221 @@
+//! Figure 10 and the experiment: the strip's island at δ = 0.10 for zero
+//! width, for the lab's ribbon, and for that ribbon under its weight with
+//! the major loop facing down and up; the photographed knot's verdicts.
+
+use crate::analysis::equilibrium::analyse;
+use crate::report::error::{Context, Result};
+use crate::scene::Scene;
+use crate::study::boundary::PolishedBoundary;
+use crate::study::start::{in_the_lab, starting_equilibrium};
+use std::fmt::Write;
+use std::path::Path;
+
+/// The four cases: scene, what it adds.
+const CASES: [(&str, &str); 4] = [
+    ("fig10_island", "(a) zero width"),
+    ("fig10_island_ribbon", "(b) ribbon w/L = 0.057"),
+    (
+        "fig10_island_down",
+        "(c) ribbon, weight 25, major loop down",
+    ),
+    ("fig10_island_up", "(d) ribbon, weight 25, major loop up"),
+];
+
+/// The photographed knot (paper Figure 10-left and Figure 1).
+const PHOTOGRAPHED: [f64; 2] = [0.17, 0.78];
+
+/// One case's island and the photographed knot in it.
+struct Case {
+    what: &'static str,
+    polished: Option<PolishedBoundary>,
+    why_not: Option<String>,
+    discrete_area: Option<f64>,
+    grid_deviation: Option<f64>,
+    gravity: Option<[f64; 3]>,
+    photographed: String,
+}
+
+/// The section "Figure 10 and the experiment".
+pub(super) fn section(scenes: &Path) -> Result<String> {
+    let mut s = String::new();
+    writeln!(s, "\n## Figure 10 and the experiment\n")?;
+    writeln!(
+        s,
+        "Commands: `cargo run --release -- map scenes/NAME.toml` for NAME in {} (N = 100, 25 lines, the boundary polished on the continuum). The strip at δ = 0.10 (Sadowsky law); the ribbon is the surface r + v d1, |v| ≤ w/2, on which walls, self-contact and crossings are measured (docs/design.md, \"Finite width\"); the weight w_g = 12(1 − ν²)ρgL³/(Eh²) ≈ 25 acts across the clamps' axis, along (down) or against (up) the weightless start's major loop at the photographed knot (z* = 0.17, φ/2π = 0.78), fixed while the island is traced.\n",
+        CASES
+            .iter()
+            .map(|(n, _)| format!("`{n}`"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )?;
+    let cases = CASES
+        .iter()
+        .map(|&(name, what)| case(scenes, name, what))
+        .collect::<Result<Vec<_>>>()?;
+    writeln!(
+        s,
+        "| case | gravity | polished area ± error | z* range | φ/2π range | corners (z*, φ/2π) | discrete area | grid ends vs walk (φ/2π) |"
+    )?;
+    writeln!(s, "|---|---|---|---|---|---|---|---|")?;
+    for c in &cases {
+        let gravity = c.gravity.map_or("none".into(), |g| {
+            format!("({:.3}, {:.3}, {:.3})", g[0], g[1], g[2])
+        });
+        let opt = |v: Option<f64>, f: &dyn Fn(f64) -> String| v.map_or("—".into(), f);
+        let discrete = opt(c.discrete_area, &|a| format!("{a:.6}"));
+        let deviation = opt(c.grid_deviation, &|d| format!("{d:.1e}"));
+        match &c.polished {
+            Some(p) => {
+                let (z, phi) = ranges(p);
+                let corners: Vec<String> = p
+                    .corners
+                    .iter()
+                    .map(|k| {
+                        format!(
+                            "{}/{} ({:.5}, {:.5}) ± {:.0e}",
+                            k.between[0], k.between[1], k.point[0], k.point[1], k.error
+                        )
+                    })
+                    .collect();
+                writeln!(
+                    s,
+                    "| {} | {gravity} | {:.7} ± {:.1e} | [{:.4}, {:.4}] | [{:.4}, {:.4}] | {} | {discrete} | {deviation} |",
+                    c.what,
+                    p.area,
+                    p.area_error,
+                    z[0],
+                    z[1],
+                    phi[0],
+                    phi[1],
+                    corners.join("; ")
+                )?;
+            }
+            None => writeln!(
+                s,
+                "| {} | {gravity} | not polished: {} | | | | {discrete} | {deviation} |",
+                c.what,
+                c.why_not.as_deref().unwrap_or("no closed boundary")
+            )?,
+        }
+    }
+    let area = |k: usize| cases[k].polished.as_ref().map(|p| p.area);
+    if let (Some(a), Some(b), Some(c), Some(d)) = (area(0), area(1), area(2), area(3)) {
+        writeln!(
+            s,
+            "\nWhat each effect does to the island's area: the width takes it from {a:.5} to {b:.5} ({:+.1} %); the weight, the major loop down, to {c:.5} ({:+.1} % of the ribbon's), up, to {d:.5} ({:+.1} %); down and up differ by {:.1} % of the ribbon's island.",
+            100.0 * (b / a - 1.0),
+            100.0 * (c / b - 1.0),
+            100.0 * (d / b - 1.0),
+            100.0 * (c - d).abs() / b
+        )?;
+    }
+    writeln!(
+        s,
+        "\nThe photographed knot (z* = {}, φ/2π = {}, δ = 0.10; the paper: good, facing down), solved at N = 100 from the unfolded double ring:\n",
+        PHOTOGRAPHED[0], PHOTOGRAPHED[1]
+    )?;
+    writeln!(s, "| case | verdict |")?;
+    writeln!(s, "|---|---|")?;
+    for c in &cases {
+        writeln!(s, "| {} | {} |", c.what, c.photographed)?;
+    }
+    Ok(s)
+}
+
+/// The case's map as `knotrod map` computes it (its gravity fixed first),
+/// and the photographed knot under its model.
+fn case(scenes: &Path, name: &'static str, what: &'static str) -> Result<Case> {
+    let scene = Scene::load(&scenes.join(format!("{name}.toml")))?;
+    let gravity = scene.load.major_loop.is_some();
+    let scene = in_the_lab(&scene, None)?.into_owned();
+    let spec = scene.map.clone().context("fig10 scene has no [map]")?;
+    let cont = scene
+        .continuation
+        .as_ref()
+        .context("fig10 scene has no [continuation]")?;
+    let map = super::islands::island_map(&scene, &spec, name, cont.parameter, cont.range)?;
+    let traced = map.traced.as_ref();
+    Ok(Case {
+        what,
+        polished: traced.and_then(|t| t.polished.clone()),
+        why_not: traced.and_then(|t| t.not_polished.as_ref().map(|f| f.to_string())),
+        discrete_area: traced.filter(|t| t.closed).and_then(|t| t.area),
+        grid_deviation: traced.and_then(|t| t.grid_check.as_ref().map(|g| g.max_deviation)),
+        gravity: gravity.then_some(scene.load.direction),
+        photographed: photographed(&scene, traced.and_then(|t| t.polished.as_ref()))?,
+    })
+}
+
+/// Whether the photographed knot is a good knot under the scene's model,
+/// and why not; and whether the polished boundary encloses it.
+fn photographed(scene: &Scene, polished: Option<&PolishedBoundary>) -> Result<String> {
+    let mut at = scene.clone();
+    at.map = None;
+    at.clamps.z_star = PHOTOGRAPHED[0];
+    at.clamps.phi_over_2pi = PHOTOGRAPHED[1];
+    let (mut newton, state, report) = starting_equilibrium(&at, None)?;
+    let eq = analyse(&mut newton, &state, &report, &at.measure())?;
+    let mut why = Vec::new();
+    if !eq.walled {
+        why.push(format!("not walled (clearance {:.4})", eq.wall_distance));
+    }
+    if !eq.stable {
+        why.push("unstable".to_string());
+    }
+    if !eq.knotted {
+        why.push(format!(
+            "not the trefoil ({})",
+            eq.knot_name.as_deref().unwrap_or("no knot type")
+        ));
+    }
+    if eq.min_self_distance <= 0.0 {
+        why.push("touching itself".to_string());
+    }
+    let verdict = if eq.good_knot {
+        format!(
+            "good (wall clearance {:.4}, self-distance {:.4}, lowest ω² {:.1})",
+            eq.wall_distance,
+            eq.min_self_distance,
+            eq.omega_squared.first().copied().unwrap_or(f64::NAN)
+        )
+    } else if why.is_empty() {
+        "not good".to_string()
+    } else {
+        format!("not good: {}", why.join(", "))
+    };
+    let inside = polished.map(|p| {
+        let ring: Vec<[f64; 2]> = p.pieces.iter().flat_map(|q| q.points.clone()).collect();
+        if encloses(&ring, PHOTOGRAPHED) {
+            "; inside the polished island"
+        } else {
+            "; outside the polished island"
+        }
+    });
+    Ok(format!("{verdict}{}", inside.unwrap_or_default()))
+}
+
+/// The polished boundary's extent in z* and φ/2π.
+fn ranges(p: &PolishedBoundary) -> ([f64; 2], [f64; 2]) {
+    let mut z = [f64::INFINITY, f64::NEG_INFINITY];
+    let mut phi = z;
+    for q in p.pieces.iter().flat_map(|q| &q.points) {
+        z = [z[0].min(q[0]), z[1].max(q[0])];
+        phi = [phi[0].min(q[1]), phi[1].max(q[1])];
+    }
+    (z, phi)
+}
+
+/// Whether the closed polygon `ring` winds round `p` (even–odd rule).
+fn encloses(ring: &[[f64; 2]], p: [f64; 2]) -> bool {
+    let mut inside = false;
+    for (k, a) in ring.iter().enumerate() {
+        let b = ring[(k + 1) % ring.len()];
+        if (a[1] > p[1]) != (b[1] > p[1]) {
+            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+            if x > p[0] {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
