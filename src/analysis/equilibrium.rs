@@ -164,7 +164,7 @@ pub struct Walls {
 
 /// The ribbon of `state` (segment k of its centreline carries edge k's d1)
 /// with its centreline and arc lengths.
-fn ribbon_data(state: &RodState) -> (Vec<Vector3<f64>>, Vec<f64>, Vec<Vector3<f64>>) {
+pub fn ribbon_data(state: &RodState) -> (Vec<Vector3<f64>>, Vec<f64>, Vec<Vector3<f64>>) {
     let (points, arc) = state.centreline();
     // the centreline's segment k is (part of) edge k, the clamps' included
     let d1 = (0..points.len() - 1)

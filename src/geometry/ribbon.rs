@@ -178,6 +178,16 @@ impl Ribbon<'_> {
         (before + after).try_normalize(1e-12).unwrap_or(after)
     }
 
+    /// Edge `sign` (±1) of segment k's piece: from point k's end of its
+    /// crossbar to point k + 1's (continuous from one piece to the next).
+    pub fn edge(&self, k: usize, sign: f64) -> [Vector3<f64>; 2] {
+        let a = sign * (0.5 * self.width);
+        [
+            self.points[k] + a * self.across(k),
+            self.points[k + 1] + a * self.across(k + 1),
+        ]
+    }
+
     /// The piece of segment k, between the crossbars at its two points.
     pub fn piece(&self, k: usize) -> Piece {
         Piece::between(

@@ -2,6 +2,7 @@
 //! strands (with their flip images), stability.
 
 use crate::geometry::distance::segment_distance;
+use crate::geometry::ribbon::Ribbon;
 use crate::solve::event::Vanishing;
 use nalgebra::Vector3;
 
@@ -97,73 +98,32 @@ fn signed_segments(
     (d, (pb - pa).dot(&n) / n.norm().max(1e-300))
 }
 
-/// A strip's ribbon's two edges as the walk follows them: the polylines
-/// pₖ ± (w/2) aₖ through the centreline's points, aₖ the direction the
-/// ribbon runs across there ([`crate::geometry::ribbon::Ribbon::across`]),
-/// the long edges of its pieces: continuous, so their distances are too,
-/// and tending to the continuum ribbon's edges r ± (w/2) d1.
-#[derive(Clone, Debug)]
-pub(super) struct Edges {
-    /// The director across at each centreline point.
-    across: Vec<Vector3<f64>>,
-    /// Half the width.
-    half: f64,
-}
-
-impl Edges {
-    /// The edges of the ribbon of width `width` whose segment k carries the
-    /// director `d1[k]`.
-    pub(super) fn new(points: &[Vector3<f64>], d1: &[Vector3<f64>], width: f64) -> Edges {
-        let ribbon = crate::geometry::ribbon::Ribbon { points, d1, width };
-        let across = (0..=d1.len()).map(|k| ribbon.across(k)).collect();
-        Edges {
-            across,
-            half: 0.5 * width,
-        }
-    }
-
-    /// Edge `sign` (±1) along segment k.
-    fn edge(&self, points: &[Vector3<f64>], k: usize, sign: f64) -> [Vector3<f64>; 2] {
-        let a = sign * self.half;
-        [
-            points[k] + a * self.across[k],
-            points[k + 1] + a * self.across[k + 1],
-        ]
-    }
-
-    /// The ribbon's gap at two strands whose centrelines cross near segments
-    /// i and j: the least over the four pairs of edges of their signed
-    /// distance (each pair's closest segments within `window` of i and j),
-    /// times `sign`. Two narrow ribbons crossing at an angle first touch
-    /// edge to edge, so it vanishes where the ribbon first touches itself
-    /// there.
-    pub(super) fn gap(
-        &self,
-        points: &[Vector3<f64>],
-        i: usize,
-        j: usize,
-        window: usize,
-        sign: f64,
-    ) -> f64 {
-        let segments = points.len() - 1;
-        let near = |k: usize| k.saturating_sub(window)..(k + window + 1).min(segments);
-        let mut gap = f64::INFINITY;
-        for (sa, sb) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
-            let mut best = (f64::INFINITY, 0.0);
-            for a in near(i) {
-                let [a0, a1] = self.edge(points, a, sa);
-                for b in near(j).filter(|&b| b >= a + 2) {
-                    let [b0, b1] = self.edge(points, b, sb);
-                    let (d, signed) = signed_segments(&a0, &a1, &b0, &b1);
-                    if d < best.0 {
-                        best = (d, signed);
-                    }
+/// The gap of the ribbon `ribbon` at two strands whose centrelines cross
+/// near segments i and j: the least over the four pairs of its edges
+/// ([`Ribbon::edge`]: continuous, so their distances are too, tending to the
+/// continuum's r ± (w/2) d1) of their signed distance, each pair's closest
+/// segments sought within `window` of i and j, times `sign`. Two narrow
+/// ribbons crossing at an angle first touch edge to edge, so it vanishes
+/// where the ribbon first touches itself there.
+pub(super) fn ribbon_gap(ribbon: &Ribbon, i: usize, j: usize, window: usize, sign: f64) -> f64 {
+    let segments = ribbon.points.len() - 1;
+    let near = |k: usize| k.saturating_sub(window)..(k + window + 1).min(segments);
+    let mut gap = f64::INFINITY;
+    for (sa, sb) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+        let mut best = (f64::INFINITY, 0.0);
+        for a in near(i) {
+            let [a0, a1] = ribbon.edge(a, sa);
+            for b in near(j).filter(|&b| b >= a + 2) {
+                let [b0, b1] = ribbon.edge(b, sb);
+                let (d, signed) = signed_segments(&a0, &a1, &b0, &b1);
+                if d < best.0 {
+                    best = (d, signed);
                 }
             }
-            gap = gap.min(sign * best.1);
         }
-        gap
+        gap = gap.min(sign * best.1);
     }
+    gap
 }
 
 impl Strands {
@@ -275,10 +235,14 @@ mod tests {
             let across_a = Vector3::new(0.0, tilt.cos(), tilt.sin());
             let across_b = Vector3::new(tilt.cos(), 0.0, tilt.sin());
             let d1 = vec![across_a, across_a, across_a, across_b, across_b];
-            let edges = Edges::new(&points, &d1, w);
+            let ribbon = Ribbon {
+                points: &points,
+                d1: &d1,
+                width: w,
+            };
             // the crossing is at points 1 and 4, whose directors are their
             // strands' own (the joining segment's mixes in at points 2, 3)
-            edges.gap(&points, 0, 3, 1, 1.0)
+            ribbon_gap(&ribbon, 0, 3, 1, 1.0)
         };
         for h in [0.3, 0.1, 0.05] {
             // sign: t_a × t_b = x × y = z, so b above a is positive

@@ -2,7 +2,7 @@
 //! pseudo-arclength continuation in the plane, corners where another property
 //! fails, equilibria by Newton at fixed clamps.
 
-use crate::analysis::equilibrium::{Measure, walls};
+use crate::analysis::equilibrium::{Measure, ribbon_data, walls};
 use crate::geometry::closure::closure_knot_along;
 use crate::geometry::ribbon::Ribbon;
 use crate::model::rod::{Clamps, Parameter, RodState};
@@ -12,7 +12,7 @@ use crate::solve::continuation::{Point, Tracer};
 use crate::solve::event::Vanishing;
 use crate::solve::step::{Acceptance, StepControl, Trial};
 use crate::study::boundary::condition::{
-    Condition, Edges, OtherStrand, Strands, closest_strands, strand_distance,
+    Condition, OtherStrand, Strands, closest_strands, ribbon_gap, strand_distance,
 };
 use crate::study::boundary::polish::polish_boundary;
 use crate::study::boundary::traced::{Traced, Trail, TrailPoint, merge_crossings, name_pieces};
@@ -69,13 +69,6 @@ struct Walk<'t, 'a> {
     bounds: [[f64; 2]; 2],
     max_step: f64,
     equilibria: usize,
-}
-
-/// Director d1 of each centreline segment of `state` (the clamps' included).
-fn directors(state: &RodState) -> Vec<nalgebra::Vector3<f64>> {
-    (0..state.centreline().0.len() - 1)
-        .map(|k| state.directors(k)[0])
-        .collect()
 }
 
 /// How many segments along each strand a ribbon's touch may lie from the
@@ -195,10 +188,15 @@ impl Walk<'_, '_> {
                     // a strip's ribbon touches itself before its centreline
                     // crosses (a ray, the closure's, has no width)
                     OtherStrand::Segment(j) if self.measure.strip_width > 0.0 => {
-                        let d1 = directors(state);
-                        let edges = Edges::new(&points, &d1, self.measure.strip_width);
-                        let window = ribbon_window(self.measure.strip_width, segments);
-                        edges.gap(&points, s.first, j, window, s.sign)
+                        let width = self.measure.strip_width;
+                        let (points, _, d1) = ribbon_data(state);
+                        let ribbon = Ribbon {
+                            points: &points,
+                            d1: &d1,
+                            width,
+                        };
+                        let window = ribbon_window(width, segments);
+                        ribbon_gap(&ribbon, s.first, j, window, s.sign)
                     }
                     _ => s.sign * best.1,
                 }
@@ -268,46 +266,32 @@ impl Walk<'_, '_> {
         if skip != Some(Vanishing::Singularity) && site.point.negative_count > 0 {
             return Ok(Some(Vanishing::Singularity));
         }
-        let good = self.measure.good.clone();
-        let (width, gap) = (self.measure.strip_width, self.measure.self_distance_gap);
-        // on a crossing of the ribbon, its own pieces (and their flip
-        // image's) may still touch at their corners a step into the good
-        // side, where the edges the walk follows are apart: they are left
-        // out of the check
-        let followed = match on {
-            Some(Condition::Crossing(s)) => Some(*s),
-            _ => None,
+        // on a crossing the knot is checked a step into the good side
+        let off;
+        let checked = if skip == Some(Vanishing::StrandGap) {
+            off = self.equilibrium_at(site, along(site.p, normal, FD))?;
+            &off.point.state
+        } else {
+            state
         };
         // a ribbon touches itself before its centreline crosses: so that
-        // boundary first (see `condition_of`)
-        let passage = |s: &RodState| {
-            let touching = width > 0.0 && {
-                let (points, arc) = s.centreline();
-                let d1 = directors(s);
-                let window = ribbon_window(width, points.len() - 1);
-                let skip = |i: usize, j: usize| {
-                    followed.is_some_and(|f| f.near_within(i, OtherStrand::Segment(j), window))
-                };
-                let ribbon = Ribbon {
-                    points: &points,
-                    d1: &d1,
-                    width,
-                };
-                ribbon.touching_pair(&arc, gap, &skip).is_some()
-            };
-            if touching {
-                return Some(Vanishing::RibbonGap);
-            }
-            let knot = closure_knot_along(&s.centreline().0, s.ray_directions()).ok();
-            let knotted = good.is_knot(knot.as_ref().map(|k| k.alexander.as_slice()));
-            (!knotted).then_some(Vanishing::StrandGap)
+        // boundary first (see `condition_of`). On a crossing of the ribbon,
+        // its own pieces (and their flip image's) may still touch at their
+        // corners a step into the good side, where the edges the walk
+        // follows are apart: they are left out of the check
+        let followed: &[Strands] = match on {
+            Some(Condition::Crossing(s)) => std::slice::from_ref(s),
+            _ => &[],
         };
-        if skip == Some(Vanishing::StrandGap) {
-            let off = self.equilibrium_at(site, along(site.p, normal, FD))?;
-            Ok(passage(&off.point.state))
-        } else {
-            Ok(passage(state))
+        if self.measure.strip_width > 0.0 && self.touching_strands(checked, followed).is_some() {
+            return Ok(Some(Vanishing::RibbonGap));
         }
+        let knot = closure_knot_along(&checked.centreline().0, checked.ray_directions()).ok();
+        let knotted = self
+            .measure
+            .good
+            .is_knot(knot.as_ref().map(|k| k.alexander.as_slice()));
+        Ok((!knotted).then_some(Vanishing::StrandGap))
     }
 
     /// The condition behind a failure at the site `bad`, just past a corner
@@ -350,8 +334,7 @@ impl Walk<'_, '_> {
         except: &[Strands],
     ) -> Option<(usize, OtherStrand)> {
         let width = self.measure.strip_width;
-        let (points, arc) = state.centreline();
-        let d1 = directors(state);
+        let (points, arc, d1) = ribbon_data(state);
         let window = ribbon_window(width, points.len() - 1);
         let skip = |i: usize, j: usize| {
             except
