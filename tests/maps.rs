@@ -385,4 +385,5 @@ fn several_maps_are_drawn_on_one_plane() {
     );
     refused(&["plot", t, s, "--out", o], "map files");
     refused(&["plot", t, t, "--name", "one", "--out", o], "--name");
+    refused(&["plot", t, t, "--mark", "k=nan,0.8", "--out", o], "--mark");
 }

@@ -74,9 +74,12 @@ pub fn overlay(
             let parse = || -> Option<(&str, [f64; 2])> {
                 let (name, at) = m.split_once('=')?;
                 let (a, b) = at.split_once(',')?;
-                Some((name, [a.trim().parse().ok()?, b.trim().parse().ok()?]))
+                let at: [f64; 2] = [a.trim().parse().ok()?, b.trim().parse().ok()?];
+                at.iter().all(|v| v.is_finite()).then_some((name, at))
             };
-            Some(parse().with_context(|| format!("--mark {m:?}: expected NAME=SWEPT,ALONG"))?)
+            Some(parse().with_context(|| {
+                format!("--mark {m:?}: expected NAME=SWEPT,ALONG (finite numbers)")
+            })?)
         }
         None => None,
     };
