@@ -77,6 +77,56 @@ fn a_rod_of_natural_curvature_pi_with_a_free_end_rests_as_the_semicircle() {
     assert!(runs[2].2 < 1e-4, "{runs:?}");
 }
 
+/// A plastified rod given by its end deflection (the scene's
+/// `natural_strains = { end_deflection = 0.05 }`, as the lab's strips of
+/// Figure 10 were), held at one end and free at the other, rests with its
+/// free end that far off the held end's tangent, at second order in N.
+#[test]
+fn a_plastified_rod_free_at_one_end_rests_at_its_end_deflection() {
+    let offset = |n: usize| {
+        let text = format!(
+            "[model]\nsegments = {n}\nstretching_stiffness = 1e8\n\
+             natural_strains = {{ end_deflection = 0.05 }}\n\
+             [clamps]\nz_star = 1.0\nend = \"free\"\n[solver]\ngradient_tol = 1e-12\n"
+        );
+        let scene = Scene::parse(&text).unwrap();
+        let u = scene.rod_model(None).natural_strains.at(0.0);
+        assert!(
+            u[0] > 0.1 && u[0] < 0.101 && u[1] == 0.0 && u[2] == 0.0,
+            "{u:?}"
+        );
+        let eq = solve_scene(&scene, None).unwrap();
+        assert!(eq.converged, "N = {n}");
+        // the held end sits at the origin with its tangent along z
+        let end = eq.state.end_point();
+        (end.x.powi(2) + end.y.powi(2)).sqrt()
+    };
+    // coarse N: the discrete arc's error (~1e-7 at N = 25) stays well above
+    // the solver's tolerance
+    let errors: Vec<f64> = [10, 20, 40]
+        .into_iter()
+        .map(|n| (offset(n) - 0.05).abs())
+        .collect();
+    eprintln!("plastified rod's end deflection − 0.05, N = 10, 20, 40: {errors:?}");
+    for k in 0..2 {
+        let p = order(errors[k], errors[k + 1]);
+        assert!(p > 1.8 && p < 2.2, "{errors:?}: order {p}");
+    }
+    assert!(errors[2] < 1e-6, "{errors:?}");
+    for bad in ["0.9", "nan", "{ end_deflection = 0.05, width = 1 }"] {
+        let text = if bad.starts_with('{') {
+            format!("[model]\nnatural_strains = {bad}\n")
+        } else {
+            format!("[model]\nnatural_strains = {{ end_deflection = {bad} }}\n")
+        };
+        assert!(Scene::parse(&text).is_err(), "accepted {text}");
+    }
+    let msg = Scene::parse("[model]\nnatural_strains = { end_deflection = 0.9 }\n")
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("natural_strains.end_deflection"), "{msg}");
+}
+
 /// A heavy rod of K2 = 3, K3 = 2 clamped at the origin and pinned at s = 1.
 fn pinned_rod(n: usize) -> String {
     format!(

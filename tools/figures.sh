@@ -57,3 +57,21 @@ done
     --out "$T/fig10" >/dev/null
 cp "$T/fig10.png" "$F/fig10_islands.png"
 echo "map written to $F/fig10_islands.png"
+
+# plastification: the ribbon's island (b) as the region, its plastified
+# islands (end deflection ±5 %) and those facing down under the weight
+for name in fig10_island_plastic_plus fig10_island_plastic_minus \
+    fig10_island_down_plastic_plus fig10_island_down_plastic_minus; do
+    "$K" map scenes/$name.toml --json "$T/$name.map.json" >/dev/null 2>&1
+done
+"$K" plot "$T/fig10_island_ribbon.map.json" "$T/fig10_island_plastic_plus.map.json" \
+    "$T/fig10_island_plastic_minus.map.json" "$T/fig10_island_down.map.json" \
+    "$T/fig10_island_down_plastic_plus.map.json" "$T/fig10_island_down_plastic_minus.map.json" \
+    --name "(b) ribbon w/L = 0.057" --name "(e+) (b) plastified, û1 > 0" \
+    --name "(e−) (b) plastified, û1 < 0" --name "(c) (b), weight 25, loop down" \
+    --name "(f+) (c) plastified, û1 > 0" --name "(f−) (c) plastified, û1 < 0" \
+    --mark "photographed knot=0.17,0.78" \
+    --title "Figure 10, plastified strips (end deflection ±5 %, N = 100, polished)" \
+    --out "$T/fig10_plastic" >/dev/null
+cp "$T/fig10_plastic.png" "$F/fig10_plastified.png"
+echo "map written to $F/fig10_plastified.png"

@@ -899,11 +899,14 @@ fn island_outline(map: &crate::study::map::Map) -> Option<Vec<(f64, f64)>> {
 }
 
 /// Colours of the overlaid curves after the region (distinct on white).
-const CURVES: [RGBColor; 4] = [
+const CURVES: [RGBColor; 7] = [
     RGBColor(20, 20, 20),
     RGBColor(200, 40, 40),
     RGBColor(30, 80, 200),
     RGBColor(150, 90, 0),
+    RGBColor(130, 50, 170),
+    RGBColor(0, 140, 150),
+    RGBColor(230, 120, 170),
 ];
 
 fn draw_overlay<DB: DrawingBackend>(

@@ -112,6 +112,37 @@ impl NaturalStrains {
     }
 }
 
+/// Largest end deflection of a naturally curved rod's stress-free arc, in
+/// units of L: (1 − cos û)/û peaks at û ≈ 2.33 (the arc then bends back).
+pub const MOST_END_DEFLECTION: f64 = 0.72;
+
+/// The uniform natural curvature û (units of 1/L) of a plastified rod whose
+/// stress-free shape, held at one end, has its free end `deflection` (units
+/// of L, signed as û) off the held end's tangent: the arc's
+/// (1 − cos û)/û = |deflection|. `None` for a deflection that is not finite or
+/// beyond [`MOST_END_DEFLECTION`].
+pub fn arc_curvature(deflection: f64) -> Option<f64> {
+    if !deflection.is_finite() || deflection.abs() > MOST_END_DEFLECTION {
+        return None;
+    }
+    let d = deflection.abs();
+    let offset = |u: f64| {
+        if u < 1e-4 {
+            // (1 − cos u)/u by its series: no cancellation near 0
+            u / 2.0 - u.powi(3) / 24.0
+        } else {
+            (1.0 - u.cos()) / u
+        }
+    };
+    // the offset rises monotonically on [0, 2.33]: bisection to the last bit
+    let (mut lo, mut hi) = (0.0, 2.33);
+    while hi - lo > f64::EPSILON * hi {
+        let mid = 0.5 * (lo + hi);
+        if offset(mid) < d { lo = mid } else { hi = mid }
+    }
+    Some(deflection.signum() * 0.5 * (lo + hi))
+}
+
 /// Linear interpolation in rows sorted by s (held at the end rows outside).
 fn interpolate(rows: &[[f64; 4]], s: f64) -> [f64; 3] {
     let (Some(first), Some(last)) = (rows.first(), rows.last()) else {
@@ -150,5 +181,39 @@ mod tests {
         let c = NaturalStrains::from([1.0, 0.0, 2.0]);
         assert_eq!(c.at_vertex(3, 10), [1.0, 0.0, 2.0]);
         assert!(c.component_is_zero(1) && !c.is_zero());
+    }
+
+    /// The arc of the curvature found for a deflection, integrated on its own
+    /// (the tangent turning at û, Simpson's rule for the end's offset), ends
+    /// that far off the held end's tangent; small deflections give û ≈ 2d.
+    #[test]
+    fn a_plastified_rod_s_arc_ends_at_the_asked_deflection() {
+        for d in [0.05, -0.05, 1e-6, 0.3, 0.7] {
+            let u = arc_curvature(d).unwrap();
+            let n = 2000;
+            let f = |s: f64| (u * s).sin();
+            let simpson = (0..=n)
+                .map(|k| {
+                    let w = if k == 0 || k == n {
+                        1.0
+                    } else if k % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    };
+                    w * f(k as f64 / n as f64)
+                })
+                .sum::<f64>()
+                / (3.0 * n as f64);
+            assert!(
+                (simpson - d).abs() < 1e-12 * (1.0 + u.abs()),
+                "d {d}: û {u}, arc ends {simpson}"
+            );
+        }
+        let u = arc_curvature(0.05).unwrap();
+        assert!((u - 0.1).abs() < 1e-3 && u > 0.1, "û {u} for 5 %");
+        assert_eq!(arc_curvature(0.0), Some(0.0));
+        assert_eq!(arc_curvature(0.8), None);
+        assert_eq!(arc_curvature(f64::NAN), None);
     }
 }

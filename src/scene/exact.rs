@@ -42,8 +42,10 @@ pub fn option_list<'de, D: Deserializer<'de>, const N: usize>(
         .transpose()
 }
 
-/// Natural strains: exactly three numbers [û1, û2, û3], or a table of rows
-/// of exactly four [s, û1, û2, û3].
+/// Natural strains: exactly three numbers [û1, û2, û3], a table of rows of
+/// exactly four [s, û1, û2, û3], or `{ end_deflection = d }`: the plastified
+/// rod's uniform û1 whose stress-free arc, held at one end, ends d·L off the
+/// held end's tangent (`model::natural::arc_curvature`).
 pub fn natural<'de, D: Deserializer<'de>>(
     d: D,
 ) -> Result<crate::model::natural::NaturalStrains, D::Error> {
@@ -53,12 +55,28 @@ pub fn natural<'de, D: Deserializer<'de>>(
     enum Raw {
         Triple(Vec<f64>),
         Rows(Vec<Vec<f64>>),
+        Arc(Arc),
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Arc {
+        end_deflection: f64,
     }
     match Raw::deserialize(d).map_err(|_| {
         D::Error::custom(
-            "natural_strains: expected [û1, û2, û3] or a table of rows [s, û1, û2, û3]",
+            "natural_strains: expected [û1, û2, û3], a table of rows [s, û1, û2, û3] or { end_deflection = d }",
         )
     })? {
+        Raw::Arc(Arc { end_deflection }) => {
+            crate::model::natural::arc_curvature(end_deflection)
+                .map(|u| NaturalStrains::Constant([u, 0.0, 0.0]))
+                .ok_or_else(|| {
+                    D::Error::custom(format!(
+                        "natural_strains.end_deflection: {end_deflection} is not a deflection an arc reaches (|d| ≤ {} of the length)",
+                        crate::model::natural::MOST_END_DEFLECTION
+                    ))
+                })
+        }
         Raw::Triple(v) => to_array(v).map(NaturalStrains::Constant),
         Raw::Rows(rows) => rows
             .into_iter()

@@ -112,7 +112,9 @@ pub struct ModelSpec {
     pub stretching_stiffness: Option<f64>,
     /// Natural strains (û1, û2, û3) in units of 1/L: constant along the rod,
     /// or a table of rows [s, û1, û2, û3] linearly interpolated in s (û2 = 0
-    /// for the unbendable law, û2 = û3 = 0 for the strip).
+    /// for the unbendable law, û2 = û3 = 0 for the strip), or
+    /// `{ end_deflection = d }`: a plastified rod's uniform û1 whose
+    /// stress-free arc, held at one end, ends d·L off its tangent.
     #[serde(default, deserialize_with = "exact::natural")]
     pub natural_strains: NaturalStrains,
     /// Strips only: width w/L of the ribbon along d1 on which the

@@ -10,8 +10,9 @@ use crate::study::start::{in_the_lab, starting_equilibrium};
 use std::fmt::Write;
 use std::path::Path;
 
-/// The four cases: scene, what it adds.
-const CASES: [(&str, &str); 4] = [
+/// The cases: scene, what it adds. The first four are the paper's figure's
+/// (checked again from N = 200), the rest plastify (b) and (c).
+const CASES: [(&str, &str); 8] = [
     ("fig10_island", "(a) zero width"),
     ("fig10_island_ribbon", "(b) ribbon w/L = 0.057"),
     (
@@ -19,7 +20,23 @@ const CASES: [(&str, &str); 4] = [
         "(c) ribbon, weight 25, major loop down",
     ),
     ("fig10_island_up", "(d) ribbon, weight 25, major loop up"),
+    ("fig10_island_plastic_plus", "(e+) (b) plastified, û1 > 0"),
+    ("fig10_island_plastic_minus", "(e−) (b) plastified, û1 < 0"),
+    (
+        "fig10_island_down_plastic_plus",
+        "(f+) (c) plastified, û1 > 0",
+    ),
+    (
+        "fig10_island_down_plastic_minus",
+        "(f−) (c) plastified, û1 < 0",
+    ),
 ];
+
+/// The cases checked again from N = 200.
+const FINE_CHECKED: usize = 4;
+
+/// The lab strips' end deflection once unclamped (paper Sec. 5: "about 5 %").
+const END_DEFLECTION: f64 = 0.05;
 
 /// The photographed knot (paper Figure 10-left and Figure 1).
 const PHOTOGRAPHED: [f64; 2] = [0.17, 0.78];
@@ -51,9 +68,17 @@ pub(super) fn section(scenes: &Path) -> Result<String> {
             .collect::<Vec<_>>()
             .join(", ")
     )?;
+    let plastic =
+        crate::model::natural::arc_curvature(END_DEFLECTION).context("the lab's end deflection")?;
+    writeln!(
+        s,
+        "Plastification (e±, f±): the lab's strips were slightly plastified, \"an end deflection of about {:.0} % of the length once unclamped\". Read as a uniform natural curvature û1 whose stress-free arc, held at one end, ends {END_DEFLECTION}·L off its tangent ((1 − cos û1)/û1 = {END_DEFLECTION}): |û1| = {plastic:.6} (scenes: `natural_strains = {{ end_deflection = ±{END_DEFLECTION} }}`); û1 > 0 turns the tangent towards −d2. The paper says neither its sign nor its direction, so both are computed.\n",
+        100.0 * END_DEFLECTION
+    )?;
     let cases = CASES
         .iter()
-        .map(|&(name, what)| case(scenes, name, what))
+        .enumerate()
+        .map(|(k, &(name, what))| case(scenes, name, what, k < FINE_CHECKED))
         .collect::<Result<Vec<_>>>()?;
     writeln!(
         s,
@@ -123,6 +148,16 @@ pub(super) fn section(scenes: &Path) -> Result<String> {
             100.0 * (d / b - 1.0),
             100.0 * (c - d).abs() / b
         )?;
+        if let (Some(ep), Some(em), Some(fp), Some(fm)) = (area(4), area(5), area(6), area(7)) {
+            writeln!(
+                s,
+                "Plastification takes the ribbon's island to {ep:.5} (û1 > 0, {:+.1} %) or {em:.5} (û1 < 0, {:+.1} %), and the island under its weight facing down to {fp:.5} ({:+.1} % of (c)'s) or {fm:.5} ({:+.1} %).",
+                100.0 * (ep / b - 1.0),
+                100.0 * (em / b - 1.0),
+                100.0 * (fp / c - 1.0),
+                100.0 * (fm / c - 1.0),
+            )?;
+        }
     }
     writeln!(
         s,
@@ -139,7 +174,7 @@ pub(super) fn section(scenes: &Path) -> Result<String> {
 
 /// The case's map as `knotrod map` computes it (its gravity fixed first),
 /// and the photographed knot under its model.
-fn case(scenes: &Path, name: &'static str, what: &'static str) -> Result<Case> {
+fn case(scenes: &Path, name: &'static str, what: &'static str, fine: bool) -> Result<Case> {
     let scene = Scene::load(&scenes.join(format!("{name}.toml")))?;
     let gravity = scene.load.major_loop.is_some();
     let scene = in_the_lab(&scene, None)?.into_owned();
@@ -152,7 +187,7 @@ fn case(scenes: &Path, name: &'static str, what: &'static str) -> Result<Case> {
     let traced = map.traced.as_ref();
     // the ribbon's islands again from N = 200: the polish removes the
     // discrete rod's error, so the areas agree to their bars
-    let at_200 = if scene.model.strip_width > 0.0 {
+    let at_200 = if fine && scene.model.strip_width > 0.0 {
         let mut fine = scene.clone();
         fine.model.segments = 200;
         let m = super::islands::island_map(&fine, &spec, name, cont.parameter, cont.range)?;
