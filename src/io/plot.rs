@@ -1,8 +1,8 @@
 //! Bifurcation diagrams in the paper's style: the (φ/2π, Tw) plane with
-//! segments coloured green (good knot), blue (stable, knotted, not walled),
-//! brown (unknotted), red (unstable), events labelled; below, the lowest ω²
-//! and the minimum self-distance along the branches. SVG always; PNG when a
-//! TrueType font is found for the labels.
+//! segments coloured green (good knot), blue (stable, knotted, not walled or
+//! touching itself), brown (unknotted), red (unstable), events labelled;
+//! below, the lowest ω² and the minimum self-distance along the branches.
+//! SVG always; PNG when a TrueType font is found for the labels.
 
 use crate::analysis::class::Class;
 use crate::analysis::equilibrium::Equilibrium;
@@ -146,7 +146,10 @@ pub(crate) fn font_available() -> bool {
 /// The paper's classes as the legend names them, in its order.
 const LEGEND: [(Class, &str); 4] = [
     (Class::Good, "good knot"),
-    (Class::StableUnwalled, "stable knot, not walled"),
+    (
+        Class::StableUnwalled,
+        "stable knot, unwalled or touching itself",
+    ),
     (Class::Unknotted, "unknotted"),
     (Class::Unstable, "unstable"),
 ];

@@ -13,7 +13,7 @@ pub struct Body {
     /// Draw a ribbon of this width along d1 instead of a tube (a strip).
     pub ribbon: Option<f64>,
     /// The class colour (the paper's: green good knot, blue stable knotted
-    /// not walled, brown unknotted, red unstable).
+    /// but unwalled or touching itself, brown unknotted, red unstable).
     pub colour: [u8; 3],
     /// Its name (an event's label, or the user's: A, B as in Figure 4).
     pub label: String,

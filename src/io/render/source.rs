@@ -115,7 +115,7 @@ fn body(f: Found, ribbon: Option<f64>, scene_width: Option<f64>) -> Body {
 fn class_name(c: Class) -> &'static str {
     match c {
         Class::Good => "good knot",
-        Class::StableUnwalled => "stable knot, not walled",
+        Class::StableUnwalled => "stable knot, unwalled or touching itself",
         Class::Unknotted => "unknotted",
         Class::Unstable => "unstable",
         Class::None => "",

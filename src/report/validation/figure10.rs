@@ -11,8 +11,8 @@ use std::fmt::Write;
 use std::path::Path;
 
 /// The cases: scene, what it adds. The first four are the paper's figure's
-/// (checked again from N = 200), the rest plastify (b) and (c).
-const CASES: [(&str, &str); 8] = [
+/// (checked again from N = 200), the rest plastify (b), (c) and (d).
+const CASES: [(&str, &str); 10] = [
     ("fig10_island", "(a) zero width"),
     ("fig10_island_ribbon", "(b) ribbon w/L = 0.057"),
     (
@@ -29,6 +29,14 @@ const CASES: [(&str, &str); 8] = [
     (
         "fig10_island_down_plastic_minus",
         "(f−) (c) plastified, û1 < 0",
+    ),
+    (
+        "fig10_island_up_plastic_plus",
+        "(g+) (d) plastified, û1 > 0",
+    ),
+    (
+        "fig10_island_up_plastic_minus",
+        "(g−) (d) plastified, û1 < 0",
     ),
 ];
 
@@ -72,7 +80,7 @@ pub(super) fn section(scenes: &Path) -> Result<String> {
         crate::model::natural::arc_curvature(END_DEFLECTION).context("the lab's end deflection")?;
     writeln!(
         s,
-        "Plastification (e±, f±): the lab's strips were slightly plastified, \"an end deflection of about {:.0} % of the length once unclamped\". Read as a uniform natural curvature û1 whose stress-free arc, held at one end, ends {END_DEFLECTION}·L off its tangent ((1 − cos û1)/û1 = {END_DEFLECTION}): |û1| = {plastic:.6} (scenes: `natural_strains = {{ end_deflection = ±{END_DEFLECTION} }}`); û1 > 0 turns the tangent towards −d2. The paper says neither its sign nor its direction, so both are computed.\n",
+        "Plastification (e±, f±, g±): the lab's strips were slightly plastified, \"an end deflection of about {:.0} % of the length once unclamped\". Read as a uniform natural curvature û1 whose stress-free arc, held at one end, ends {END_DEFLECTION}·L off its tangent ((1 − cos û1)/û1 = {END_DEFLECTION}): |û1| = {plastic:.6} (scenes: `natural_strains = {{ end_deflection = ±{END_DEFLECTION} }}`); û1 > 0 turns the tangent towards −d2. The paper says neither its sign nor its direction, so both are computed.\n",
         100.0 * END_DEFLECTION
     )?;
     let cases = CASES
@@ -148,14 +156,18 @@ pub(super) fn section(scenes: &Path) -> Result<String> {
             100.0 * (d / b - 1.0),
             100.0 * (c - d).abs() / b
         )?;
-        if let (Some(ep), Some(em), Some(fp), Some(fm)) = (area(4), area(5), area(6), area(7)) {
+        if let (Some(ep), Some(em), Some(fp), Some(fm), Some(gp), Some(gm)) =
+            (area(4), area(5), area(6), area(7), area(8), area(9))
+        {
             writeln!(
                 s,
-                "Plastification takes the ribbon's island to {ep:.5} (û1 > 0, {:+.1} %) or {em:.5} (û1 < 0, {:+.1} %), and the island under its weight facing down to {fp:.5} ({:+.1} % of (c)'s) or {fm:.5} ({:+.1} %).",
+                "Plastification takes the ribbon's island to {ep:.5} (û1 > 0, {:+.1} %) or {em:.5} (û1 < 0, {:+.1} %); under its weight facing down to {fp:.5} ({:+.1} % of (c)'s) or {fm:.5} ({:+.1} %), facing up to {gp:.5} ({:+.1} % of (d)'s) or {gm:.5} ({:+.1} %).",
                 100.0 * (ep / b - 1.0),
                 100.0 * (em / b - 1.0),
                 100.0 * (fp / c - 1.0),
                 100.0 * (fm / c - 1.0),
+                100.0 * (gp / d - 1.0),
+                100.0 * (gm / d - 1.0),
             )?;
         }
     }
