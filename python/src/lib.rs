@@ -729,9 +729,16 @@ fn map_scene<'py>(
     allow_large: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     check_segments(segments)?;
-    let s = &scene.scene;
-    s.check_budget(Job::Map, segments, allow_large)
+    let raw = &scene.scene;
+    raw.check_budget(Job::Map, segments, allow_large)
         .map_err(|e| scene_error(&e, None))?;
+    // gravity fixed in the lab once (`[load] major_loop`), as the CLI does:
+    // the walk and every line then start from the same resolved scene
+    let lab = detached(py, || {
+        knotrod::study::start::in_the_lab(raw, segments).map(|c| c.into_owned())
+    })?
+    .map_err(|e| study_error(py, &e, None, &raw.rod_model(segments)))?;
+    let s = &lab;
     let (Some(spec), Some(cont)) = (s.map.clone(), s.continuation.clone()) else {
         let err = SceneError::new_err("the scene needs [map] and [continuation] sections");
         err.value(py).setattr("field", "map")?;
