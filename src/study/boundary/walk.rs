@@ -72,9 +72,13 @@ struct Walk<'t, 'a> {
 }
 
 /// How many segments along each strand a ribbon's touch may lie from the
-/// centrelines' closest points: 3, and the ribbon's width in segments.
+/// centrelines' closest points: 3, and twice the ribbon's width in segments.
+/// Strands crossing at a shallow angle θ touch by their edges up to
+/// (w/2)/tan θ along from the centrelines' closest points, past one width for
+/// θ < 27°: the Figure 10 ribbon's touch at N = 200 lay 19 segments along,
+/// beyond a window of one width (15), and was taken for another crossing.
 fn ribbon_window(width: f64, segments: usize) -> usize {
-    3 + (width * segments as f64).ceil() as usize
+    3 + (2.0 * width * segments as f64).ceil() as usize
 }
 
 /// A parameter in messages: φ as the paper writes it, others by their name.
