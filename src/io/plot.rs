@@ -440,18 +440,38 @@ where
     }
     let (top, bottom) = body.split_vertically((body.dim_in_pixel().1 as f64 * 0.55) as u32);
     let (mid, low) = bottom.split_vertically(bottom.dim_in_pixel().1 / 2);
-    let finite = |v: f64| v.is_finite();
     let xs: Vec<f64> = eqs.iter().map(|e| e.phi_over_2pi).collect();
-    let (x0, x1) = bounds(&xs);
+    let x = bounds(&xs);
+    draw_twist_panel(&root, &top, x, eqs, events)?;
+    draw_omega_panel(&root, &mid, x, eqs)?;
+    draw_distance_panel(&low, x, eqs)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// One width for the three panels' tick labels, so their x axes align.
+const Y_LABEL_AREA: u32 = 78;
+
+/// The (φ/2π, Tw) panel: the branches coloured by class, the events
+/// marked and labelled (placed on `root`, clear of each other).
+fn draw_twist_panel<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    top: &DrawingArea<DB, Shift>,
+    (x0, x1): (f64, f64),
+    eqs: &[PlotPoint],
+    events: &[Event],
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     let tw: Vec<f64> = eqs.iter().map(|e| e.twist).collect();
     let (y0, y1) = bounds(&tw);
-    // one width for the three panels' tick labels, so their x axes align
-    let y_area = 78;
-    let mut chart = ChartBuilder::on(&top)
+    let mut chart = ChartBuilder::on(top)
         .margin(8)
         .margin_right(18)
         .x_label_area_size(34)
-        .y_label_area_size(y_area)
+        .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
     chart
@@ -499,28 +519,40 @@ where
         .collect();
     let (px, py) = chart.plotting_area().get_pixel_range();
     place_labels(
-        &root,
+        root,
         &labels,
         (px.start, py.start, px.end, py.end),
         &("sans-serif", 14).into_font().color(&BLACK),
-    )?;
-    // lowest ω² on a symmetric log scale: its sign changes show
+    )
+}
+
+/// The lowest ω² panel on a symmetric log scale (its sign changes show),
+/// its ticks drawn here on `root`: plotters would place them evenly in the
+/// transformed value.
+fn draw_omega_panel<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    mid: &DrawingArea<DB, Shift>,
+    (x0, x1): (f64, f64),
+    eqs: &[PlotPoint],
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     let om: Vec<f64> = eqs
         .iter()
         .filter_map(|e| e.omega_squared)
-        .filter(|v| finite(*v))
+        .filter(|v| v.is_finite())
         .collect();
     let log = SymLog::for_values(&om);
     let (o0, o1) = bounds(&om.iter().map(|v| log.to(*v)).collect::<Vec<_>>());
-    let mut c2 = ChartBuilder::on(&mid)
+    let mut c2 = ChartBuilder::on(mid)
         .margin(8)
         .margin_right(18)
         .x_label_area_size(26)
-        .y_label_area_size(y_area)
+        .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, o0..o1)
         .map_err(err)?;
-    // the ticks drawn here: plotters would place them evenly in the
-    // transformed value
     c2.configure_mesh()
         .y_desc(if log.linear {
             "lowest ω²"
@@ -590,17 +622,30 @@ where
             .map_err(err)?;
         }
     }
+    Ok(())
+}
+
+/// The least self-distance panel.
+fn draw_distance_panel<DB: DrawingBackend>(
+    low: &DrawingArea<DB, Shift>,
+    (x0, x1): (f64, f64),
+    eqs: &[PlotPoint],
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     let sd: Vec<f64> = eqs
         .iter()
         .map(|e| e.min_self_distance)
-        .filter(|v| finite(*v))
+        .filter(|v| v.is_finite())
         .collect();
     let (s0, s1) = bounds(&sd);
-    let mut c3 = ChartBuilder::on(&low)
+    let mut c3 = ChartBuilder::on(low)
         .margin(8)
         .margin_right(18)
         .x_label_area_size(34)
-        .y_label_area_size(y_area)
+        .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, s0.min(0.0)..s1)
         .map_err(err)?;
     c3.configure_mesh()
@@ -620,7 +665,6 @@ where
         c3.draw_series(LineSeries::new(pts, RGBColor(40, 90, 200).stroke_width(2)))
             .map_err(err)?;
     }
-    root.present().map_err(err)?;
     Ok(())
 }
 
