@@ -386,4 +386,20 @@ fn several_maps_are_drawn_on_one_plane() {
     refused(&["plot", t, s, "--out", o], "map files");
     refused(&["plot", t, t, "--name", "one", "--out", o], "--name");
     refused(&["plot", t, t, "--mark", "k=nan,0.8", "--out", o], "--mark");
+    // one map with the overlay's options is drawn by them, not without them
+    refused(&["plot", t, "--mark", "k=nan,0.8", "--out", o], "--mark");
+    let single = dir.join("single");
+    knotrod_ok(&[
+        "plot",
+        t,
+        "--mark",
+        "a knot=0.15,0.8",
+        "--out",
+        single.to_str().unwrap(),
+    ]);
+    let svg = std::fs::read_to_string(single.with_extension("svg")).unwrap();
+    assert!(
+        svg.contains("a knot"),
+        "the mark not in the single map's plot"
+    );
 }

@@ -126,15 +126,15 @@ pub enum Command {
         /// Output stem (default: the first file's path without extension).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Several maps: the name of each in the legend, once per map in
-        /// order (default: their scenes').
+        /// Maps drawn on one plane: the name of each in the legend, once per
+        /// map in order (default: their scenes').
         #[arg(long = "name")]
         names: Vec<String>,
-        /// Several maps: a point to mark, NAME=SWEPT,ALONG (e.g. "photographed
-        /// knot=0.17,0.78" for z*, φ/2π).
+        /// Maps drawn on one plane (one map too): a point to mark,
+        /// NAME=SWEPT,ALONG (e.g. "photographed knot=0.17,0.78" for z*, φ/2π).
         #[arg(long)]
         mark: Option<String>,
-        /// Several maps: the title.
+        /// Maps drawn on one plane (one map too): the title.
         #[arg(long)]
         title: Option<String>,
     },
@@ -271,7 +271,9 @@ pub fn main_with(cli: Cli) -> Result<()> {
             mark,
             title,
         } => match summary.as_slice() {
-            [one] => plot::plot(one, out),
+            // a map's own options (--name, --mark, --title) draw it as the
+            // maps are drawn together, never silently dropped
+            [one] if names.is_empty() && mark.is_none() && title.is_none() => plot::plot(one, out),
             many => plot::overlay(many, out, &names, mark.as_deref(), title.as_deref()),
         },
         Command::Map {

@@ -58,7 +58,7 @@ pub fn overlay(
                 .with_context(|| format!("cannot read {}", f.display()))?;
             serde_json::from_str::<Map>(&text).with_context(|| {
                 format!(
-                    "{}: several files are drawn together only as map files (`map --json`)",
+                    "{}: several files, or one with --name, --mark or --title, are drawn only as map files (`map --json`)",
                     f.display()
                 )
             })

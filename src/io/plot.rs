@@ -932,13 +932,12 @@ pub fn island_overlay(
 fn island_outline(map: &crate::study::map::Map) -> Option<Vec<(f64, f64)>> {
     let t = map.traced.as_ref().filter(|t| t.closed)?;
     let mut pts: Vec<(f64, f64)> = match &t.polished {
-        Some(p) => p
-            .pieces
-            .iter()
-            .flat_map(|q| q.points.iter().map(|p| (p[1], p[0])))
-            .collect(),
-        None => t.polygon().iter().map(|p| (p[1], p[0])).collect(),
-    };
+        Some(p) => p.polygon(),
+        None => t.polygon(),
+    }
+    .iter()
+    .map(|p| (p[1], p[0]))
+    .collect();
     if let Some(&first) = pts.first() {
         pts.push(first);
     }

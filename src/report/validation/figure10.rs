@@ -265,8 +265,7 @@ fn photographed(scene: &Scene, polished: Option<&PolishedBoundary>) -> Result<St
         format!("not good: {}", why.join(", "))
     };
     let inside = polished.map(|p| {
-        let ring: Vec<[f64; 2]> = p.pieces.iter().flat_map(|q| q.points.clone()).collect();
-        if encloses(&ring, PHOTOGRAPHED) {
+        if p.encloses(PHOTOGRAPHED) {
             "; inside the polished island"
         } else {
             "; outside the polished island"
@@ -279,24 +278,9 @@ fn photographed(scene: &Scene, polished: Option<&PolishedBoundary>) -> Result<St
 fn ranges(p: &PolishedBoundary) -> ([f64; 2], [f64; 2]) {
     let mut z = [f64::INFINITY, f64::NEG_INFINITY];
     let mut phi = z;
-    for q in p.pieces.iter().flat_map(|q| &q.points) {
+    for q in p.polygon() {
         z = [z[0].min(q[0]), z[1].max(q[0])];
         phi = [phi[0].min(q[1]), phi[1].max(q[1])];
     }
     (z, phi)
-}
-
-/// Whether the closed polygon `ring` winds round `p` (even–odd rule).
-fn encloses(ring: &[[f64; 2]], p: [f64; 2]) -> bool {
-    let mut inside = false;
-    for (k, a) in ring.iter().enumerate() {
-        let b = ring[(k + 1) % ring.len()];
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-            if x > p[0] {
-                inside = !inside;
-            }
-        }
-    }
-    inside
 }

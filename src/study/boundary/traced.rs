@@ -82,6 +82,31 @@ pub struct PolishedBoundary {
     pub dropped: Vec<DroppedPoint>,
 }
 
+impl PolishedBoundary {
+    /// The pieces' points joined in walk order (swept parameter, value
+    /// along), as [`Traced::polygon`].
+    pub fn polygon(&self) -> Vec<[f64; 2]> {
+        self.pieces.iter().flat_map(|p| p.points.clone()).collect()
+    }
+
+    /// Whether the polished loop winds round the point `p` (swept
+    /// parameter, value along; even–odd rule).
+    pub fn encloses(&self, p: [f64; 2]) -> bool {
+        let ring = self.polygon();
+        let mut inside = false;
+        for (k, a) in ring.iter().enumerate() {
+            let b = ring[(k + 1) % ring.len()];
+            if (a[1] > p[1]) != (b[1] > p[1]) {
+                let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                if x > p[0] {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+}
+
 /// A walk point the boundary's polish left out.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct DroppedPoint {

@@ -779,9 +779,16 @@ impl Tour {
         walk.orient_at(&mut c, &self.at.site)?;
         let mut gradient = walk.gradient(&mut c, &good)?;
         // the region is the intersection of the good sides, so the walk
-        // leaves a corner into the old condition's good side; a crossing
-        // whose sign at the last point says otherwise is turned round
+        // leaves a corner into the old condition's good side; a crossing of
+        // the centrelines whose sign at the last point says otherwise is
+        // turned round. Not the ribbon's: its gap, the least of four edge
+        // pairs' signed distances, is no odd function of the sign (turned
+        // round it would vanish elsewhere, not at this corner), and
+        // `orient_at` made it positive on the good side already
+        let ribbon = walk.measure.strip_width > 0.0
+            && matches!(&c, Condition::Crossing(s) if matches!(s.other, OtherStrand::Segment(_)));
         if let Condition::Crossing(s) = &mut c
+            && !ribbon
             && dot2(left_tangent(gradient), normal) < 0.0
         {
             s.sign = -s.sign;
