@@ -416,24 +416,48 @@ fn the_reader_sees_imports_through_groups_super_and_re_exports() {
     );
 }
 
+/// The crate's files outside the layers `exempt` whose code contains any of
+/// `marks`.
+fn files_outside_with(exempt: &[&str], marks: &[&str]) -> Vec<String> {
+    let files = read_crate();
+    assert!(files.len() > 50, "the crate's files were read");
+    files
+        .iter()
+        .map(|(path, file)| (path.to_string_lossy().replace('\\', "/"), file))
+        .filter(|(p, _)| {
+            !exempt
+                .iter()
+                .any(|l| p.starts_with(&format!("{l}/")) || p.contains(&format!("/{l}/")))
+        })
+        .filter(|(_, file)| marks.iter().any(|m| file.code.contains(m)))
+        .map(|(p, _)| p)
+        .collect()
+}
+
 /// One predictor-corrector loop: outside `src/solve/` nothing calls the
 /// corrector itself (it steps through `Tracer::advance`); that nothing but
 /// `StepControl::advance` halves or grows a step, the compiler sees to
 /// (`shrink` and `accepted` are private to solve/step.rs).
 #[test]
 fn only_solve_calls_the_corrector() {
-    let files = read_crate();
-    let mut offenders = Vec::new();
-    for (path, file) in &files {
-        let p = path.to_string_lossy().replace('\\', "/");
-        let in_solve = p.starts_with("solve/") || p.contains("/solve/");
-        if !in_solve && file.code.contains(".correct(") {
-            offenders.push(p);
-        }
-    }
-    assert!(files.len() > 50, "the crate's files were read");
+    let offenders = files_outside_with(&["solve"], &[".correct("]);
     assert!(
         offenders.is_empty(),
         "files outside src/solve/ calling the corrector: {offenders:?}"
     );
+}
+
+/// One root finder: outside `src/solve/` (and the equations' own scalar
+/// roots in `src/model/`), roots along a family are narrowed by
+/// `solve::root` (its secant iteration and bisection), not by a loop of
+/// one's own halving a bracket.
+#[test]
+fn roots_are_narrowed_in_solve() {
+    let offenders = files_outside_with(&["solve", "model"], &["0.5 * (lo + hi)", "0.5 * (a + b)"]);
+    assert!(
+        offenders.is_empty(),
+        "files outside src/solve/ bisecting by hand: {offenders:?}"
+    );
+    // the check sees a hand-written bisection where there is one
+    assert!(!files_outside_with(&["solve"], &["0.5 * (lo + hi)"]).is_empty());
 }

@@ -18,7 +18,7 @@ use crate::scene::{InitialShape, Job, Scene, human_time};
 use crate::study::verify::{Quantity, SolutionCheck, VerifyOptions, verify_all};
 use anyhow::{Context, Result, bail, ensure};
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The command's arguments.
 #[derive(clap::Args, Debug)]
@@ -260,41 +260,55 @@ pub fn verify(a: Args) -> Result<()> {
         }
     }
     if let Some(p) = &a.report {
-        let plot = p.with_extension("svg");
-        // drawn beside a report file only (not beside a FIFO, device or `-`)
-        let beside = output_kind(p) == OutputKind::File;
-        let drawn = beside
-            && match convergence_plot(&plot, &series(&checks)) {
-                Ok(()) => true,
-                Err(e) => {
-                    eprintln!("no convergence plot: {e}");
-                    false
-                }
-            };
-        let name = plot
-            .file_name()
-            .map(|n| n.to_string_lossy().to_string())
-            .unwrap_or_default();
-        let command: Vec<String> = std::env::args()
-            .enumerate()
-            .map(|(k, a)| if k == 0 { "knotrod".into() } else { a })
-            .collect();
-        let mut text = markdown(
-            &command.join(" "),
-            &a.file.display().to_string(),
-            &checks,
-            options.segments,
-            drawn.then_some(name.as_str()),
-        );
-        if let Some(section) = &labelled {
-            text.push('\n');
-            text.push_str(section);
-        }
-        crate::io::output::write_file(p, text.as_bytes())?;
+        write_report(p, &a.file, &checks, options.segments, labelled.as_deref())?;
         if !dash(&a.report) {
             eprintln!("wrote {}", p.display());
         }
     }
+    Ok(())
+}
+
+/// The markdown report at `p` of `checks` of `file` (AUTO's labelled
+/// events after it), with its convergence plot beside it where `p` is a
+/// file.
+fn write_report(
+    p: &Path,
+    file: &Path,
+    checks: &[SolutionCheck],
+    segments: [usize; 3],
+    labelled: Option<&str>,
+) -> Result<()> {
+    let plot = p.with_extension("svg");
+    // drawn beside a report file only (not beside a FIFO, device or `-`)
+    let beside = output_kind(p) == OutputKind::File;
+    let drawn = beside
+        && match convergence_plot(&plot, &series(checks)) {
+            Ok(()) => true,
+            Err(e) => {
+                eprintln!("no convergence plot: {e}");
+                false
+            }
+        };
+    let name = plot
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let command: Vec<String> = std::env::args()
+        .enumerate()
+        .map(|(k, a)| if k == 0 { "knotrod".into() } else { a })
+        .collect();
+    let mut text = markdown(
+        &command.join(" "),
+        &file.display().to_string(),
+        checks,
+        segments,
+        drawn.then_some(name.as_str()),
+    );
+    if let Some(section) = labelled {
+        text.push('\n');
+        text.push_str(section);
+    }
+    crate::io::output::write_file(p, text.as_bytes())?;
     Ok(())
 }
 

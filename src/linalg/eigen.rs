@@ -340,6 +340,44 @@ pub fn lowest_eigenvalues_refined(
 }
 
 /// [`lowest_eigenvalues`], refined by [`rayleigh_ritz`] when `gram` is given.
+/// σ strictly below the lowest eigenvalue and within a factor 4 of it, from
+/// the counts of negatives `count(σ)` (None: singular at σ), the workspace
+/// left factorised at the σ returned: grown ×4 from 1e-8 of the largest
+/// diagonal until below it, and where that first σ is already below, moved
+/// up ×4 (down to 1e-14 of it) while it stays below. A σ far below a
+/// negative λ₁ near zero (σ = −92 for λ₁ ≈ −0.01, λ₂ ≈ 0.02 at N = 800)
+/// makes μ₁ ≈ μ₂, and Lanczos restarted 20 times there: the branch's N⁵.
+fn below_lowest(
+    negative_count: usize,
+    diag_scale: f64,
+    count: &mut dyn FnMut(f64) -> Option<usize>,
+) -> Result<f64, StabilityError> {
+    let first = -1e-8 * diag_scale;
+    let mut sigma = if negative_count == 0 { 0.0 } else { first };
+    loop {
+        match count(sigma) {
+            Some(0) if sigma < 0.0 || negative_count == 0 => break,
+            _ => {}
+        }
+        sigma = if sigma == 0.0 { first } else { sigma * 4.0 };
+        if sigma < -1e3 * diag_scale {
+            return Err(StabilityError::NoShift);
+        }
+    }
+    if sigma == first {
+        while sigma / 4.0 <= -1e-14 * diag_scale {
+            if count(sigma / 4.0) == Some(0) {
+                sigma /= 4.0;
+            } else {
+                // the workspace holds the factorisation at σ / 4: back to σ
+                count(sigma).ok_or(StabilityError::NoShift)?;
+                break;
+            }
+        }
+    }
+    Ok(sigma)
+}
+
 fn lowest_with(
     pattern: &SymmetricPattern,
     values: &[f64],
@@ -364,35 +402,9 @@ fn lowest_with(
         // singular at 0: count at a tiny negative shift (zero modes are not negative)
         None => count(-1e-12 * diag_scale, ldlt, &mut work).ok_or(StabilityError::NoShift)?,
     };
-    // σ strictly below the lowest eigenvalue and within a factor 4 of it:
-    // grown ×4 from 1e-8 of the largest diagonal until below it, and where
-    // that first σ is already below, moved up ×4 (down to 1e-14 of it) while
-    // it stays below. A σ far below a negative λ₁ near zero (σ = −92 for
-    // λ₁ ≈ −0.01, λ₂ ≈ 0.02 at N = 800) makes μ₁ ≈ μ₂, and Lanczos restarted
-    // 20 times there: the branch's N⁵.
-    let first = -1e-8 * diag_scale;
-    let mut sigma = if negative_count == 0 { 0.0 } else { first };
-    loop {
-        match count(sigma, ldlt, &mut work) {
-            Some(0) if sigma < 0.0 || negative_count == 0 => break,
-            _ => {}
-        }
-        sigma = if sigma == 0.0 { first } else { sigma * 4.0 };
-        if sigma < -1e3 * diag_scale {
-            return Err(StabilityError::NoShift);
-        }
-    }
-    if sigma == first {
-        while sigma / 4.0 <= -1e-14 * diag_scale {
-            if count(sigma / 4.0, ldlt, &mut work) == Some(0) {
-                sigma /= 4.0;
-            } else {
-                // the workspace holds the factorisation at σ / 4: back to σ
-                count(sigma, ldlt, &mut work).ok_or(StabilityError::NoShift)?;
-                break;
-            }
-        }
-    }
+    let sigma = below_lowest(negative_count, diag_scale, &mut |sigma| {
+        count(sigma, ldlt, &mut work)
+    })?;
     // reduced space: dofs with mass (all dofs for the plain problem)
     let (reduced, weight): (Vec<usize>, Vec<f64>) = match mass {
         Some(m) => (0..n)

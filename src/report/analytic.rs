@@ -12,6 +12,7 @@ use crate::model::rod::{Clamps, EndKind, RodModel, RodState};
 use crate::report::error::{ReportError, Result, fail};
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::SolverSettings;
+use crate::solve::root::bisect_predicate;
 use nalgebra::SVector;
 use std::f64::consts::PI;
 
@@ -31,18 +32,16 @@ pub fn straight_equilibrium(newton: &mut Minimizer, clamps: Clamps) -> Result<(R
 /// Bisection on the inertia: the parameter in [lo, hi] at which the state
 /// first has a negative eigenvalue (to 40 halvings).
 fn loss_of_stability(
-    mut lo: f64,
-    mut hi: f64,
+    lo: f64,
+    hi: f64,
     mut unstable: impl FnMut(f64) -> Result<bool>,
 ) -> Result<f64> {
     if unstable(lo)? || !unstable(hi)? {
         fail!("bracket [{lo}, {hi}] does not contain the loss of stability");
     }
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if unstable(mid)? { hi = mid } else { lo = mid }
-    }
-    Ok(0.5 * (lo + hi))
+    // 40 halvings
+    let narrowest = 1.5 * (hi - lo) * 2f64.powi(-40);
+    bisect_predicate(lo, hi, |lo, hi| hi - lo <= narrowest, |p| Ok(!unstable(p)?))
 }
 
 /// Compressive axial force at which a straight isotropic (K2 = 1) clamped rod
@@ -187,14 +186,6 @@ pub fn heavy_column_constant() -> Result<f64> {
             .map_err(|e| ReportError::Failed(format!("heavy column at w = {w}: {e}")))?;
         Ok(ends[0][1])
     };
-    let (mut lo, mut hi) = (6.0, 9.0);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if end_slope(mid)? > 0.0 {
-            lo = mid
-        } else {
-            hi = mid
-        }
-    }
-    Ok(0.5 * (lo + hi))
+    // to adjacent floats
+    bisect_predicate(6.0, 9.0, |_, _| false, |w| Ok(end_slope(w)? > 0.0))
 }

@@ -11,6 +11,7 @@ use crate::model::rod::{Clamps, Parameter, RodState};
 use crate::solve::kkt::Kkt;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::{FloorProbe, SolveError, floor_bound, judge};
+use crate::solve::root::{Bracket, Probe, bisect};
 use crate::solve::step::{Acceptance, StepControl, Trial};
 use serde::{Deserialize, Serialize};
 
@@ -471,29 +472,31 @@ impl<'a> Tracer<'a> {
         sigma: f64,
         same: &mut dyn FnMut(&mut Self, &Point) -> bool,
     ) -> Result<Bracketed, ContinuationError> {
-        let (mut lo, mut hi) = (0.0, sigma);
-        let mut lo_value = self.parameter_of(&from.state);
-        let mut last: Option<Point> = None;
-        while (hi - lo).abs() > self.settings.locate_tolerance {
-            let mid = 0.5 * (lo + hi);
-            // at a singular point itself the bordered system degenerates: try
-            // nearby abscissae before giving up on more precision
-            let mut found = None;
-            for shift in [0.0, 0.1, -0.1, 0.2, -0.2] {
-                if let Ok(p) = self.correct(from, mid + shift * (hi - lo), None) {
-                    found = Some((mid + shift * (hi - lo), p));
-                    break;
+        let tolerance = self.settings.locate_tolerance;
+        let b = bisect(
+            0.0,
+            sigma,
+            |lo, hi| (hi - lo).abs() <= tolerance,
+            |mid, b: &Bracket<f64, Point>| {
+                // at a singular point itself the bordered system degenerates:
+                // try nearby abscissae before giving up on more precision
+                let width = b.hi - b.lo;
+                for shift in [0.0, 0.1, -0.1, 0.2, -0.2] {
+                    let at = mid + shift * width;
+                    if let Ok(p) = self.correct(from, at, None) {
+                        return Ok::<_, ContinuationError>(if same(self, &p) {
+                            Probe::Holds(at, self.parameter_of(&p.state))
+                        } else {
+                            Probe::Fails(at, p)
+                        });
+                    }
                 }
-            }
-            let Some((at, p)) = found else { break };
-            if same(self, &p) {
-                lo = at;
-                lo_value = self.parameter_of(&p.state);
-            } else {
-                hi = at;
-                last = Some(p);
-            }
-        }
+                Ok(Probe::Stop)
+            },
+        )?;
+        let lo_value = b.holds.unwrap_or_else(|| self.parameter_of(&from.state));
+        let last = b.fails;
+        let hi = b.hi;
         let point = match last {
             Some(p) => p,
             None => self.correct(from, hi, None)?,

@@ -5,6 +5,7 @@
 
 use crate::analysis::event::{Event, EventKind};
 use crate::scene::Scene;
+use crate::solve::root::bisect_predicate;
 use crate::study::error::{Context, Result, fail};
 use crate::study::run::run_scene;
 use std::f64::consts::PI;
@@ -93,19 +94,16 @@ pub fn crosses_one_contact_curve(segments: usize, z_star: f64, delta: f64) -> Re
 /// Largest z* of the one-contact curve at end shift δ, by bisection on
 /// whether a clamp rotation from φ = 2π crosses it (to `tol` in z*).
 pub fn max_one_contact_z_star(segments: usize, delta: f64, tol: f64) -> Result<f64> {
-    let (mut lo, mut hi) = (0.15, 0.30);
+    let (lo, hi) = (0.15, 0.30);
     if !crosses_one_contact_curve(segments, lo, delta)?
         || crosses_one_contact_curve(segments, hi, delta)?
     {
         fail!("δ = {delta}: the one-contact curve's maximum is not within z* ∈ [{lo}, {hi}]");
     }
-    while hi - lo > tol {
-        let mid = 0.5 * (lo + hi);
-        if crosses_one_contact_curve(segments, mid, delta)? {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Ok(0.5 * (lo + hi))
+    bisect_predicate(
+        lo,
+        hi,
+        |lo, hi| hi - lo <= tol,
+        |z_star| crosses_one_contact_curve(segments, z_star, delta),
+    )
 }

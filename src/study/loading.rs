@@ -11,6 +11,7 @@ use crate::model::rod::{Clamps, RodState};
 use crate::scene::LoadingSpec;
 use crate::solve::minimizer::Minimizer;
 use crate::solve::outcome::{SolveError, SolveReport, SolverSettings};
+use crate::solve::root::{Bracket, Probe, bisect};
 use crate::study::error::{Context, Result, StudyError, fail};
 use crate::study::observer::Observer;
 
@@ -247,17 +248,27 @@ fn locate_on_path(
     settings: &SolverSettings,
     same: &mut dyn FnMut(&mut Minimizer, &Step) -> Result<bool>,
 ) -> Result<(RodState, Clamps)> {
-    let (mut lo, mut hi) = (from.clone(), to);
-    while lo.clamps.gap(&hi) > JUMP_LOCATION {
-        let mid = lo.clamps.midpoint(&hi);
-        let trial = move_within(newton, &lo, mid, settings, allowance)?;
-        if same(newton, &trial)? {
-            lo = trial.state;
-        } else {
-            hi = mid;
-        }
-    }
-    Ok((lo, hi))
+    // the path's fraction t from `from` (t = 0) to `to` (t = 1)
+    let at = |t: f64| from.clamps.lerp(&to, t);
+    let b = bisect(
+        0.0,
+        1.0,
+        |lo, hi| at(lo).gap(&at(hi)) <= JUMP_LOCATION,
+        |t, b: &Bracket<RodState, Clamps>| {
+            let mid = at(t);
+            let lo = b.holds.as_ref().unwrap_or(from);
+            let trial = move_within(newton, lo, mid, settings, allowance)?;
+            Ok::<_, StudyError>(if same(newton, &trial)? {
+                Probe::Holds(t, trial.state)
+            } else {
+                Probe::Fails(t, mid)
+            })
+        },
+    )?;
+    Ok((
+        b.holds.unwrap_or_else(|| from.clone()),
+        b.fails.unwrap_or(to),
+    ))
 }
 
 /// An event of a loading path at clamps `c` (its `branch` is the path's leg).

@@ -5,6 +5,7 @@ use crate::model::energy::RodEnergy;
 use crate::model::rod::{Law, RodModel};
 use crate::report::error::Result;
 use crate::scene::Scene;
+use crate::solve::root::bisect_predicate;
 use std::fmt::Write;
 
 /// The section "The double ring's stability".
@@ -57,14 +58,11 @@ fn critical_k(n: usize) -> Result<f64> {
         let sp = crate::linalg::eigen::lowest_eigenvalues(&energy.pattern, &v, None, 1, &mut ldlt)?;
         Ok(sp.values[0])
     };
-    let (mut lo, mut hi) = (1.5, 2.5);
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if lowest(mid)? > 0.0 {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    Ok(0.5 * (lo + hi))
+    // 40 halvings of [1.5, 2.5]
+    bisect_predicate(
+        1.5,
+        2.5,
+        |lo, hi| hi - lo <= 1e-12,
+        |k| Ok(lowest(k)? <= 0.0),
+    )
 }

@@ -19,6 +19,7 @@
 use crate::model::rod::{Clamps, Parameter, RodModel};
 use crate::solve::continuum::{Continuum, ContinuumError, Frame, Unknowns};
 use crate::solve::event::Vanishing;
+use crate::solve::root::{Iterate, NoRoot, Reach, Secant, SecantFailure, Start};
 use nalgebra::{Matrix6, SMatrix, SVector, Vector3, Vector6};
 
 /// A point of the branch: the unknowns (0..6) and the parameter (6).
@@ -725,62 +726,72 @@ impl<'a> ContinuumBranch<'a> {
         resolution: f64,
         test: TestFunction,
     ) -> Result<Located, BranchError> {
-        let mut za = self.correct(start, held)?;
-        let (mut test, mut ga) = self.evaluate(&za, &test)?;
+        let za = self.correct(start, held)?;
+        let (test, ga) = self.evaluate(&za, &test)?;
         let mut zb = za;
         zb[held] += step;
         zb = self.correct(zb, held)?;
-        let (t, mut gb) = self.evaluate(&zb, &test)?;
-        test = t;
-        for k in 0..SECANT_ITERATIONS {
-            if gb == 0.0 {
-                return Ok(Located {
-                    point: zb,
-                    test,
-                    value: gb,
-                    steps: k,
-                    last_step: 0.0,
-                    previous: za,
-                });
-            }
-            if gb == ga || !gb.is_finite() {
-                break;
-            }
-            let dc = -gb * (zb[held] - za[held]) / (gb - ga);
-            if dc.abs() > 1e3 * step.abs().max((zb[held] - za[held]).abs()) {
-                break;
-            }
-            // the predictor: the secant of the branch through the last two points
-            let f = dc / (zb[held] - za[held]);
-            let zc = self.correct(zb + f * (zb - za), held)?;
-            let (t, gc) = self.evaluate(&zc, &test)?;
-            test = t;
-            za = zb;
-            ga = gb;
-            zb = zc;
-            gb = gc;
-            // held at a fold, an unknown is only the path: the located
-            // quantity is the parameter, stationary there, and converged once
-            // it no longer moves at the integrator's tolerance (the test's
-            // noise may keep the unknown from reaching `resolution`)
-            let settled = held != PARAMETER
+        let (test, gb) = self.evaluate(&zb, &test)?;
+        let iterate = |z: BranchPoint, value, test| Iterate {
+            at: z[held],
+            value,
+            point: (z, test),
+        };
+        let secant = Secant {
+            max_evaluations: SECANT_ITERATIONS,
+            tolerance: resolution,
+            reach: Reach::Chord {
+                factor: 1e3,
+                floor: step.abs(),
+            },
+            ..Secant::default()
+        };
+        let start = Start::Chord(iterate(za, ga, test.clone()), iterate(zb, gb, test));
+        // the predictor: the secant of the branch through the last two points
+        type Solved = Iterate<(BranchPoint, TestFunction)>;
+        let next = |_: f64, dc: f64, b: &Solved, a: Option<&Solved>| {
+            let (zb, test) = &b.point;
+            let predicted = match a {
+                Some(Iterate { point: (za, _), .. }) => zb + dc / (zb[held] - za[held]) * (zb - za),
+                None => *zb,
+            };
+            let zc = self.correct(predicted, held)?;
+            let (test, gc) = self.evaluate(&zc, test)?;
+            Ok::<_, BranchError>(iterate(zc, gc, test))
+        };
+        // held at a fold, an unknown is only the path: the located quantity
+        // is the parameter, stationary there, and converged once it no
+        // longer moves at the integrator's tolerance (the test's noise may
+        // keep the unknown from reaching `resolution`)
+        let settled = |a: &Solved, b: &Solved| {
+            let (za, zb) = (&a.point.0, &b.point.0);
+            held != PARAMETER
                 && (zb[PARAMETER] - za[PARAMETER]).abs()
                     < self.tolerance * (1.0 + zb[PARAMETER].abs())
-                && ga.signum() != gb.signum();
-            if dc.abs() < resolution || settled {
-                return Ok(Located {
-                    point: zb,
+                && a.value.signum() != b.value.signum()
+        };
+        match secant.find(start, next, settled) {
+            Ok(root) => {
+                let (point, test) = root.last.point;
+                Ok(Located {
+                    point,
                     test,
-                    value: gb,
-                    steps: k + 1,
-                    last_step: dc,
-                    previous: za,
-                });
+                    value: root.last.value,
+                    steps: root.iterations,
+                    last_step: root.step,
+                    previous: root.previous.map_or(point, |p| p.point.0),
+                })
             }
+            Err(SecantFailure {
+                why: NoRoot::Failed(e),
+                ..
+            }) => Err(e),
+            Err(SecantFailure {
+                values: [ga, gb], ..
+            }) => Err(BranchError::NoRoot(format!(
+                "secant steps in coordinate {held} did not converge (last values {ga:.3e}, {gb:.3e})"
+            ))),
         }
-        Err(BranchError::NoRoot(format!(
-            "secant steps in coordinate {held} did not converge (last values {ga:.3e}, {gb:.3e})"
-        )))
     }
 }
 

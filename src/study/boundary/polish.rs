@@ -10,6 +10,7 @@
 
 use crate::model::rod::{Clamps, Parameter, RodModel, RodState};
 use crate::solve::continuum::branch::{BranchPoint, ContinuumBranch, PARAMETER, TestFunction};
+use crate::solve::root::{Iterate, NoRoot, Reach, Secant, SecantFailure, Start};
 use crate::study::boundary::condition::{Condition, OtherStrand};
 use crate::study::boundary::traced::{
     DroppedPoint, Piece, PolishedBoundary, PolishedCorner, Trail, TrailPoint, name_pieces,
@@ -454,56 +455,58 @@ impl Plane<'_> {
                 gb,
             ))
         };
-        let (mut pa, mut tb, mut ga) = on_a(at[held], z, &test_a, &test_b)?;
-        let (mut pb, t, mut gb) = on_a(at[held] + step, pa.z, &pa.test.clone(), &tb)?;
-        tb = t;
-        let mut visited = vec![pa.at[held], pb.at[held]];
-        let why = loop {
-            if visited.len() > CORNER_ITERATIONS {
-                break CornerFailure::NotConverged;
-            }
-            if gb == ga || !gb.is_finite() {
-                break CornerFailure::Flat(gb);
-            }
-            let dv = -gb * (pb.at[held] - pa.at[held]) / (gb - ga);
-            if dv.abs() > 0.05 {
-                return Err(PolishError::CornerLeft(dv));
-            }
-            // predict the unknowns along the chord of the last two points
-            let f = dv / (pb.at[held] - pa.at[held]);
-            let zc = pb.z + f * (pb.z - pa.z);
-            let (pc, t, gc) = match on_a(pb.at[held] + dv, zc, &pb.test.clone(), &tb) {
-                Ok(next) => next,
-                Err(e) => break CornerFailure::Step(Box::new(e)),
+        let (pa, tb, ga) = on_a(at[held], z, &test_a, &test_b)?;
+        let (pb, tb, gb) = on_a(at[held] + step, pa.z, &pa.test.clone(), &tb)?;
+        let iterate = |p: Polished, tb: TestFunction, value| Iterate {
+            at: p.at[held],
+            value,
+            point: (p, tb),
+        };
+        let secant = Secant {
+            max_evaluations: CORNER_ITERATIONS,
+            tolerance,
+            relative: true,
+            reach: Reach::Step(0.05),
+            stall: Some((STALLED_ITERATES, 1e-3)),
+            ..Secant::default()
+        };
+        let start = Start::Chord(iterate(pa, tb.clone(), ga), iterate(pb, tb, gb));
+        // predict the unknowns along the chord of the last two points
+        type Solved = Iterate<(Polished, TestFunction)>;
+        let next = |v: f64, dv: f64, b: &Solved, a: Option<&Solved>| {
+            let (pb, tb) = &b.point;
+            let zc = match a {
+                Some(Iterate { point: (pa, _), .. }) => {
+                    pb.z + dv / (pb.at[held] - pa.at[held]) * (pb.z - pa.z)
+                }
+                None => pb.z,
             };
-            tb = t;
-            (pa, ga) = (pb, gb);
-            (pb, gb) = (pc, gc);
-            visited.push(pb.at[held]);
-            if dv.abs() < tolerance * (1.0 + pb.at[held].abs()) {
-                return Ok((pb, tb, dv.abs()));
-            }
+            let (pc, tc, gc) = on_a(v, zc, &pb.test.clone(), tb)?;
+            Ok::<_, PolishError>(iterate(pc, tc, gc))
         };
         // steps stalled at the tests' noise (a corner where they vanish
-        // together, flat): the last point, its error the spread of the
-        // last iterates
-        let last = &visited[visited.len().saturating_sub(STALLED_ITERATES)..];
-        if visited.len() > STALLED_ITERATES {
-            let spread = last.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
-                - last.iter().fold(f64::INFINITY, |m, &v| m.min(v));
-            if spread < 1e-3 {
-                return Ok((pb, tb, spread));
+        // together, flat) end at the last point, its error the spread of
+        // the last iterates
+        match secant.find(start, next, |_, _| false) {
+            Ok(root) => {
+                let (corner, tb) = root.last.point;
+                Ok((corner, tb, root.error))
             }
+            Err(SecantFailure { why, values }) => Err(match why {
+                NoRoot::Left(dv) => PolishError::CornerLeft(dv),
+                NoRoot::NotConverged => PolishError::Corner(CornerFailure::NotConverged),
+                NoRoot::Flat => PolishError::Corner(CornerFailure::Flat(values[1])),
+                NoRoot::Failed(e) => PolishError::Corner(CornerFailure::Step(Box::new(e))),
+            }),
         }
-        Err(PolishError::Corner(why))
     }
 }
 
 /// Passes retrying failed boundary points from their polished neighbours.
 const RETRY_PASSES: usize = 3;
 
-/// Secant iterates a corner may take.
-const CORNER_ITERATIONS: usize = 42;
+/// Secant steps a corner may take.
+const CORNER_ITERATIONS: usize = 41;
 
 /// The iterates of a stalled corner secant whose spread is its error.
 const STALLED_ITERATES: usize = 4;

@@ -10,6 +10,7 @@ use crate::scene::MapSpec;
 use crate::scene::Scene;
 use crate::solve::continuation::{Point, Tracer};
 use crate::solve::event::Vanishing;
+use crate::solve::root::{Iterate, NoRoot, Probe, Reach, Secant, SecantFailure, Start, bisect};
 use crate::solve::step::{Acceptance, StepControl, Trial};
 use crate::study::boundary::condition::{
     Condition, OtherStrand, Strands, closest_strands, ribbon_gap, strand_distance,
@@ -385,32 +386,61 @@ impl Walk<'_, '_> {
         } else {
             0.0
         };
-        let mut site = self.equilibrium_at(from, p)?;
-        let mut g = self.value(c, &site)?;
-        let (mut s, mut slope, mut last_root) = (0.0, slope, f64::NAN);
-        for it in 1..=12 {
-            let root = s - g / slope;
-            if !root.is_finite() || root.abs() > limit {
-                fail!("corrector left the neighbourhood of {}", c.describe());
+        let site = self.equilibrium_at(from, p)?;
+        let g = self.value(c, &site)?;
+        let secant = Secant {
+            max_evaluations: 12,
+            tolerance: CORRECTOR_TOL,
+            reach: Reach::Around {
+                centre: 0.0,
+                radius: limit,
+            },
+            offset,
+            confirm: false,
+            // points too close for the lowest eigenvalue's accuracy keep
+            // the chord's slope
+            shortest_chord: if offset == 0.0 {
+                0.0
+            } else {
+                1e3 * CORRECTOR_TOL
+            },
+            ..Secant::default()
+        };
+        let start = Start::Slope(
+            Iterate {
+                at: 0.0,
+                value: g,
+                point: site,
+            },
+            slope,
+        );
+        let found = secant.find(
+            start,
+            |at, _, last, _| {
+                let next = self.equilibrium_at(&last.point, along(p, normal, at))?;
+                let value = self.value(c, &next)?;
+                Ok(Iterate {
+                    at,
+                    value,
+                    point: next,
+                })
+            },
+            |_, _| false,
+        );
+        match found {
+            Ok(root) => {
+                let mut site = root.last.point;
+                site.on = along(p, normal, root.at);
+                Ok((site, root.iterations))
             }
-            if (root - last_root).abs() <= CORRECTOR_TOL
-                || (offset == 0.0 && (root - s).abs() <= CORRECTOR_TOL)
-            {
-                site.on = along(p, normal, root);
-                return Ok((site, it));
-            }
-            let target = root + offset;
-            let next = self.equilibrium_at(&site, along(p, normal, target))?;
-            let gn = self.value(c, &next)?;
-            // secant update, unless the points are too close for the lowest
-            // eigenvalue's accuracy (then the chord's slope is kept)
-            let resolvable = offset == 0.0 || (target - s).abs() > 1e3 * CORRECTOR_TOL;
-            if gn != g && target != s && resolvable {
-                slope = (gn - g) / (target - s);
-            }
-            (s, g, site, last_root) = (target, gn, next, root);
+            Err(SecantFailure { why, .. }) => match why {
+                NoRoot::Failed(e) => Err(e),
+                NoRoot::Left(_) | NoRoot::Flat => {
+                    fail!("corrector left the neighbourhood of {}", c.describe())
+                }
+                NoRoot::NotConverged => fail!("corrector on {} did not converge", c.describe()),
+            },
         }
-        fail!("corrector on {} did not converge", c.describe())
     }
 
     /// The point of `c` a distance `s` along the tangent from the walk's
@@ -823,34 +853,29 @@ impl Tour {
         normal: [f64; 2],
         sigma: f64,
     ) -> Result<(Site, Site, Vanishing, f64)> {
-        let (mut a, mut b) = (0.0, sigma);
-        let mut good = self.at.site.clone();
-        let (mut bad, mut failure) = (q, first_failure);
         let tol = if first_failure == Vanishing::Singularity {
             STABILITY_TOL
         } else {
             1e-8
         };
-        while b - a > tol {
-            let m = 0.5 * (a + b);
-            // no equilibrium on the curve there: count it as past the corner
-            let Ok((s, _)) = walk.correct_along(&mut self.c, &self.at, m, sigma) else {
-                b = m;
-                continue;
-            };
-            match walk.failing(&s, Some(&self.c), normal)? {
-                None => {
-                    a = m;
-                    good = s;
-                }
-                Some(f) => {
-                    b = m;
-                    failure = f;
-                    bad = s;
-                }
-            }
-        }
-        Ok((good, bad, failure, b))
+        let b = bisect(
+            0.0,
+            sigma,
+            |a, b| b - a <= tol,
+            |m, _| {
+                // no equilibrium on the curve there: count it as past the corner
+                let Ok((s, _)) = walk.correct_along(&mut self.c, &self.at, m, sigma) else {
+                    return Ok(Probe::Unsolved);
+                };
+                Ok::<_, StudyError>(match walk.failing(&s, Some(&self.c), normal)? {
+                    None => Probe::Holds(m, s),
+                    Some(f) => Probe::Fails(m, (s, f)),
+                })
+            },
+        )?;
+        let good = b.holds.unwrap_or_else(|| self.at.site.clone());
+        let (bad, failure) = b.fails.unwrap_or((q, first_failure));
+        Ok((good, bad, failure, b.hi))
     }
 }
 
