@@ -193,3 +193,49 @@ fn the_corrector_refuses_a_point_held_just_past_a_fold_where_no_solution_exists(
         other => panic!("past the fold: {other:?}"),
     }
 }
+
+/// The continuum Jacobian's parameter column, for a parameter of the s = 1
+/// clamp alone taken on the one end state, equals central differences of
+/// whole integrations at the two parameter values; parameters that change
+/// the rod's equations or its start are not taken that way.
+#[test]
+fn an_end_clamp_parameters_column_is_that_of_whole_integrations() {
+    use knotrod::model::rod::{Clamps, Parameter};
+    let scene = Scene::load(Path::new("scenes/appendix_d.toml")).unwrap();
+    let model = scene.rod_model(Some(60));
+    let clamps = Clamps::new(0.115, 0.05, 0.802);
+    // the Appendix D knot's shooting unknowns (scenes/fig7_island_kirchhoff.toml)
+    let p = Unknowns::new(-24.743, 17.772, 37.145, 7.5317, -8.71, 4.529);
+    for parameter in [
+        Parameter::ZStar,
+        Parameter::Delta,
+        Parameter::Phi,
+        Parameter::EndX,
+        Parameter::EndTilt,
+    ] {
+        assert!(parameter.moves_end_only());
+        let branch = ContinuumBranch::new(&model, clamps, parameter, 1e-12).unwrap();
+        let value = parameter.value(&clamps);
+        let mut z = BranchPoint::zeros();
+        z.fixed_rows_mut::<6>(0).copy_from(&p);
+        z[PARAMETER] = value;
+        let column = branch
+            .linearise(&z)
+            .unwrap()
+            .1
+            .column(PARAMETER)
+            .into_owned();
+        let h = 1e-6 * (1.0 + value.abs());
+        let at = |v: f64| branch.problem(v).unwrap().residual(&p).unwrap();
+        let whole = (at(value + h) - at(value - h)) / (2.0 * h);
+        let error = (column - whole).norm();
+        assert!(
+            error < 1e-5 * whole.norm().max(1.0),
+            "{parameter:?}: {error:.2e} of {:.2e}",
+            whole.norm()
+        );
+    }
+    for parameter in [Parameter::StartTilt, Parameter::K3, Parameter::Weight] {
+        assert!(!parameter.moves_end_only(), "{parameter:?}");
+    }
+}

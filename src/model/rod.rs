@@ -1366,6 +1366,22 @@ impl Parameter {
         Parameter::MODEL.contains(self)
     }
 
+    /// Whether it moves the s = 1 clamp alone: the rod's equations and its
+    /// start are then the same at every value, and only the s = 1
+    /// conditions change with it.
+    pub fn moves_end_only(&self) -> bool {
+        matches!(
+            self,
+            Parameter::ZStar
+                | Parameter::Delta
+                | Parameter::Phi
+                | Parameter::EndX
+                | Parameter::EndY
+                | Parameter::EndTilt
+                | Parameter::EndTiltAzimuth
+        )
+    }
+
     /// Every clamp coordinate, in the order of the scene format's documentation.
     pub const ALL: [Parameter; 13] = [
         Parameter::ZStar,

@@ -213,16 +213,26 @@ impl<'a> ContinuumBranch<'a> {
     }
 
     /// The s = 1 residual at z and its Jacobian in all seven coordinates
-    /// (the parameter's column by central differences).
+    /// (the parameter's column by central differences: of the s = 1
+    /// conditions alone where the parameter moves only that clamp).
     pub fn linearise(
         &self,
         z: &BranchPoint,
     ) -> Result<(Vector6<f64>, SMatrix<f64, 6, 7>), BranchError> {
         let p: Unknowns = z.fixed_rows::<6>(0).into();
-        let (r, jp) = self.problem(z[PARAMETER])?.linearise(&p)?;
+        let (r, jp, end) = self.problem(z[PARAMETER])?.linearise_to_end(&p)?;
         let h = 1e-6 * (1.0 + z[PARAMETER].abs());
-        let plus = self.problem(z[PARAMETER] + h)?.residual(&p)?;
-        let minus = self.problem(z[PARAMETER] - h)?.residual(&p)?;
+        // a parameter of the s = 1 clamp alone changes only the s = 1
+        // conditions: their change on the same end state (two
+        // integrations fewer, and free of the integrator's noise)
+        let at = |value: f64| -> Result<Vector6<f64>, BranchError> {
+            let problem = self.problem(value)?;
+            Ok(match &end {
+                Some(y) if self.parameter.moves_end_only() => problem.residual_of_end(y),
+                _ => problem.residual(&p)?,
+            })
+        };
+        let (plus, minus) = (at(z[PARAMETER] + h)?, at(z[PARAMETER] - h)?);
         let mut jac = SMatrix::<f64, 6, 7>::zeros();
         jac.fixed_columns_mut::<6>(0).copy_from(&jp);
         jac.set_column(PARAMETER, &((plus - minus) / (2.0 * h)));

@@ -29,6 +29,10 @@ use crate::solve::continuum::newton::{NewtonShootingFailure, central_jacobian, n
 use nalgebra::{Matrix6, SVector, Vector3, Vector6};
 use std::f64::consts::PI;
 
+/// The s = 1 residual, its Jacobian in the unknowns, and the rod's state at
+/// s = 1 they came from (None for a strip).
+pub(crate) type Linearised = (Vector6<f64>, Matrix6<f64>, Option<OdeState>);
+
 /// Why a continuum solution could not be made.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum ContinuumError {
@@ -337,6 +341,13 @@ impl Continuum {
     /// its directional derivative is an exact central difference); for a
     /// strip, from central differences of whole integrations.
     pub fn linearise(&self, p: &Unknowns) -> Result<(Vector6<f64>, Matrix6<f64>), ContinuumError> {
+        self.linearise_to_end(p).map(|(r, jac, _)| (r, jac))
+    }
+
+    /// [`Self::linearise`], with the rod's state at s = 1 it came from (None
+    /// for a strip): the residual under other s = 1 clamps is
+    /// [`Self::residual_of_end`] of it, no integration.
+    pub(crate) fn linearise_to_end(&self, p: &Unknowns) -> Result<Linearised, ContinuumError> {
         check_finite(p)?;
         let ContinuumLaw::Kirchhoff { k2, k3 } = self.law else {
             let r = self.residual(p)?;
@@ -348,18 +359,13 @@ impl Continuum {
             if jac.iter().any(|v| !v.is_finite()) {
                 return Err(ContinuumError::Singular);
             }
-            return Ok((r, jac));
+            return Ok((r, jac, None));
         };
         let y0 = self.variational_start(p);
         let f = |s: f64, y: &SVector<f64, VARIATIONAL>| self.variational_rhs(s, y, k2, k3, 0.0);
         let end = integrate_stops(y0, f, self.tolerance, &[1.0])?.0[0];
         let core: OdeState = end.fixed_rows::<19>(0).into();
-        let residual_of = |y: &OdeState| {
-            self.end_residual(
-                [part(y, 0), part(y, 1), part(y, 3)],
-                (part(y, 4), part(y, 5)),
-            )
-        };
+        let residual_of = |y: &OdeState| self.residual_of_end(y);
         let r = residual_of(&core);
         let mut jac = Matrix6::zeros();
         for c in 0..6 {
@@ -374,7 +380,16 @@ impl Continuum {
         if jac.iter().any(|v| !v.is_finite()) {
             return Err(ContinuumError::Singular);
         }
-        Ok((r, jac))
+        Ok((r, jac, Some(core)))
+    }
+
+    /// The s = 1 conditions of this problem's clamps on a rod's state at
+    /// s = 1.
+    pub(crate) fn residual_of_end(&self, y: &OdeState) -> Vector6<f64> {
+        self.end_residual(
+            [part(y, 0), part(y, 1), part(y, 3)],
+            (part(y, 4), part(y, 5)),
+        )
     }
 
     /// The rod's state at s = 0 from `p` and its derivatives in the six
