@@ -3,6 +3,7 @@
 //! N⁻² beside it.
 
 use crate::io::error::{IoError, Result};
+use crate::io::plot::plot_error;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -14,8 +15,7 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, series: &[Series]) -> 
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(plot_error)?;
     let points: Vec<(f64, f64)> = series
         .iter()
         .flat_map(|(_, p)| p.iter().copied())
@@ -44,20 +44,20 @@ where
             (x0 / 1.2..x1 * 1.2).log_scale(),
             (y0 / 3.0..y1 * 3.0).log_scale(),
         )
-        .map_err(err)?;
+        .map_err(plot_error)?;
     chart
         .configure_mesh()
         .x_desc("N")
         .y_desc("relative distance")
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .draw()
-        .map_err(err)?;
+        .map_err(plot_error)?;
     let legend = series.len() <= 8;
     for (k, (label, p)) in series.iter().enumerate() {
         let colour = Palette99::pick(k).to_rgba();
         let line = chart
             .draw_series(LineSeries::new(p.iter().copied(), colour.stroke_width(2)))
-            .map_err(err)?;
+            .map_err(plot_error)?;
         if legend {
             line.label(label.clone()).legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
@@ -65,7 +65,7 @@ where
         }
         chart
             .draw_series(p.iter().map(|&q| Circle::new(q, 3, colour.filled())))
-            .map_err(err)?;
+            .map_err(plot_error)?;
     }
     // the slope of a second-order method through the first curve's start
     if let Some((_, p)) = series.iter().find(|(_, p)| !p.is_empty()) {
@@ -75,7 +75,7 @@ where
                 [(n, e * 2.0), (x1, e * 2.0 * (n / x1).powi(2))],
                 BLACK.stroke_width(1),
             ))
-            .map_err(err)?
+            .map_err(plot_error)?
             .label("N⁻²")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
     }
@@ -84,8 +84,8 @@ where
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()
-        .map_err(err)?;
-    root.present().map_err(err)?;
+        .map_err(plot_error)?;
+    root.present().map_err(plot_error)?;
     Ok(())
 }
 

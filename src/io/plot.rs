@@ -164,7 +164,6 @@ fn draw_head<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     let width = head.dim_in_pixel().0 as i32;
     let centred = |s: TextStyle<'static>| {
         s.pos(plotters::style::text_anchor::Pos::new(
@@ -177,7 +176,7 @@ where
         (width / 2, 6),
         centred(("sans-serif", 18).into_font().color(&BLACK)),
     ))
-    .map_err(err)?;
+    .map_err(plot_error)?;
     let font = ("sans-serif", 13).into_font().color(&BLACK);
     let entries: Vec<(RGBColor, &str, i32)> = LEGEND
         .iter()
@@ -201,13 +200,13 @@ where
             vec![(x, y), (x + sample, y)],
             c.stroke_width(3),
         ))
-        .map_err(err)?;
+        .map_err(plot_error)?;
         head.draw(&Text::new(
             name.to_string(),
             (x + sample + 6, y - 7),
             font.clone(),
         ))
-        .map_err(err)?;
+        .map_err(plot_error)?;
         x += sample + 6 + w + gap;
     }
     Ok(())
@@ -232,7 +231,6 @@ fn place_labels<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     type Rect = (i32, i32, i32, i32);
     let overlaps = |a: &Rect, b: &Rect| a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
     let dots: Vec<Rect> = labels
@@ -295,13 +293,13 @@ where
             [(chosen.0 - 2, chosen.1 - 1), (chosen.2 + 2, chosen.3 + 1)],
             WHITE.mix(0.8).filled(),
         ))
-        .map_err(err)?;
+        .map_err(plot_error)?;
         area.draw(&Text::new(
             l.text.clone(),
             (chosen.0, chosen.1),
             font.clone(),
         ))
-        .map_err(err)?;
+        .map_err(plot_error)?;
         placed.push(chosen);
     }
     Ok(())
@@ -412,8 +410,7 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(plot_error)?;
     let mut present: Vec<RGBColor> = Vec::new();
     for e in eqs {
         if !present.contains(&e.colour) {
@@ -436,7 +433,7 @@ where
                 ),
             ),
         ))
-        .map_err(err)?;
+        .map_err(plot_error)?;
     }
     let (top, bottom) = body.split_vertically((body.dim_in_pixel().1 as f64 * 0.55) as u32);
     let (mid, low) = bottom.split_vertically(bottom.dim_in_pixel().1 / 2);
@@ -445,7 +442,7 @@ where
     draw_twist_panel(&root, &top, x, eqs, events)?;
     draw_omega_panel(&root, &mid, x, eqs)?;
     draw_distance_panel(&low, x, eqs)?;
-    root.present().map_err(err)?;
+    root.present().map_err(plot_error)?;
     Ok(())
 }
 
@@ -464,7 +461,6 @@ fn draw_twist_panel<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     let tw: Vec<f64> = eqs.iter().map(|e| e.twist).collect();
     let (y0, y1) = bounds(&tw);
     let mut chart = ChartBuilder::on(top)
@@ -473,7 +469,7 @@ where
         .x_label_area_size(34)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
+        .map_err(plot_error)?;
     chart
         .configure_mesh()
         .x_desc("φ/2π")
@@ -482,7 +478,7 @@ where
         .y_label_formatter(&|v| tick_text(*v))
         .light_line_style(WHITE.mix(0.0))
         .draw()
-        .map_err(err)?;
+        .map_err(plot_error)?;
     for leg in legs(eqs) {
         for w in leg.windows(2) {
             // a segment takes the class of its unstable end, if any
@@ -499,7 +495,7 @@ where
                     ],
                     colour.stroke_width(3),
                 ))
-                .map_err(err)?;
+                .map_err(plot_error)?;
         }
     }
     let labelled: Vec<&Event> = events.iter().filter(|e| !e.label.is_empty()).collect();
@@ -509,7 +505,7 @@ where
                 .iter()
                 .map(|e| Circle::new((e.phi_over_2pi, e.twist), 4, BLACK.filled())),
         )
-        .map_err(err)?;
+        .map_err(plot_error)?;
     let labels: Vec<Label> = labelled
         .iter()
         .map(|e| Label {
@@ -538,7 +534,6 @@ fn draw_omega_panel<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     let om: Vec<f64> = eqs
         .iter()
         .filter_map(|e| e.omega_squared)
@@ -552,7 +547,7 @@ where
         .x_label_area_size(26)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, o0..o1)
-        .map_err(err)?;
+        .map_err(plot_error)?;
     c2.configure_mesh()
         .y_desc(if log.linear {
             "lowest ω²"
@@ -563,7 +558,7 @@ where
         .y_labels(0)
         .light_line_style(WHITE.mix(0.0))
         .draw()
-        .map_err(err)?;
+        .map_err(plot_error)?;
     let tick_font =
         ("sans-serif", 12)
             .into_font()
@@ -584,22 +579,22 @@ where
             [(x0, tick), (x1, tick)],
             BLACK.mix(0.12).stroke_width(1),
         ))
-        .map_err(err)?;
+        .map_err(plot_error)?;
         root.draw(&PathElement::new(vec![(x - 5, y), (x, y)], BLACK))
-            .map_err(err)?;
+            .map_err(plot_error)?;
         root.draw(&Text::new(
             tick_text(log.from(tick)),
             (x - 8, y),
             tick_font.clone(),
         ))
-        .map_err(err)?;
+        .map_err(plot_error)?;
     }
     if o0 < 0.0 && o1 > 0.0 {
         c2.draw_series(LineSeries::new(
             [(x0, 0.0), (x1, 0.0)],
             BLACK.mix(0.7).stroke_width(1),
         ))
-        .map_err(err)?;
+        .map_err(plot_error)?;
     }
     for leg in legs(eqs) {
         // coloured by stability, as the diagram above
@@ -619,7 +614,7 @@ where
                 ],
                 colour.stroke_width(2),
             ))
-            .map_err(err)?;
+            .map_err(plot_error)?;
         }
     }
     Ok(())
@@ -634,7 +629,6 @@ fn draw_distance_panel<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
     let sd: Vec<f64> = eqs
         .iter()
         .map(|e| e.min_self_distance)
@@ -647,7 +641,7 @@ where
         .x_label_area_size(34)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, s0.min(0.0)..s1)
-        .map_err(err)?;
+        .map_err(plot_error)?;
     c3.configure_mesh()
         .x_desc("φ/2π")
         .y_desc("min self-distance")
@@ -655,7 +649,7 @@ where
         .y_label_formatter(&|v| tick_text(*v))
         .light_line_style(WHITE.mix(0.0))
         .draw()
-        .map_err(err)?;
+        .map_err(plot_error)?;
     for leg in legs(eqs) {
         let pts: Vec<(f64, f64)> = leg
             .iter()
@@ -663,7 +657,7 @@ where
             .map(|e| (e.phi_over_2pi, e.min_self_distance))
             .collect();
         c3.draw_series(LineSeries::new(pts, RGBColor(40, 90, 200).stroke_width(2)))
-            .map_err(err)?;
+            .map_err(plot_error)?;
     }
     Ok(())
 }
@@ -817,12 +811,11 @@ fn draw_slices<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e| IoError::Plot(format!("{e:?}"));
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(plot_error)?;
     for (area, m) in root.split_evenly(grid).into_iter().zip(&map.slices) {
         draw_map(area, m)?;
     }
-    root.present().map_err(err)
+    root.present().map_err(plot_error)
 }
 
 fn draw_map<DB: DrawingBackend>(
@@ -832,8 +825,7 @@ fn draw_map<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(plot_error)?;
     let mut present: Vec<RGBColor> = Vec::new();
     for c in map.grid.iter().flatten().filter(|c| **c != Class::None) {
         if !present.contains(&colour_of(*c)) {
@@ -851,7 +843,7 @@ where
         .x_label_area_size(35)
         .y_label_area_size(62)
         .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
+        .map_err(plot_error)?;
     chart
         .configure_mesh()
         .x_desc(map.along.symbol())
@@ -860,7 +852,7 @@ where
         .y_label_formatter(&|v| tick_text(*v))
         .light_line_style(WHITE.mix(0.0))
         .draw()
-        .map_err(err)?;
+        .map_err(plot_error)?;
     for (row, l) in map.grid.iter().zip(&map.lines) {
         for (c, x) in row.iter().zip(&map.grid_along) {
             if *c == Class::None {
@@ -869,7 +861,7 @@ where
             let col = colour_of(*c);
             chart
                 .draw_series(std::iter::once(Circle::new((*x, l.value), 2, col.filled())))
-                .map_err(err)?;
+                .map_err(plot_error)?;
         }
     }
     let mut labels = Vec::new();
@@ -878,7 +870,7 @@ where
         let pts: Vec<(f64, f64)> = pts.iter().map(|p| (p[1], p[0])).collect();
         chart
             .draw_series(LineSeries::new(pts.clone(), BLACK.stroke_width(2)))
-            .map_err(err)?;
+            .map_err(plot_error)?;
         if let Some(at) = pts.get(pts.len() / 2) {
             labels.push(Label {
                 text: name.clone(),
@@ -894,7 +886,7 @@ where
         (px.start, py.start, px.end, py.end),
         &("sans-serif", 16).into_font().color(&BLACK),
     )?;
-    root.present().map_err(err)?;
+    root.present().map_err(plot_error)?;
     Ok(())
 }
 
@@ -964,8 +956,7 @@ fn draw_overlay<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| IoError::Plot(format!("{e:?}"));
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(plot_error)?;
     let outlines = maps
         .iter()
         .map(|(name, m)| {
@@ -1004,7 +995,7 @@ where
         .x_label_area_size(38)
         .y_label_area_size(62)
         .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
+        .map_err(plot_error)?;
     chart
         .configure_mesh()
         .x_desc(along.symbol())
@@ -1013,13 +1004,13 @@ where
         .y_label_formatter(&|v| tick_text(*v))
         .light_line_style(WHITE.mix(0.0))
         .draw()
-        .map_err(err)?;
+        .map_err(plot_error)?;
     let region = colour_of(Class::Good);
     for (k, (name, pts)) in outlines.iter().enumerate() {
         if k == 0 {
             chart
                 .draw_series(std::iter::once(Polygon::new(pts.clone(), region.mix(0.45))))
-                .map_err(err)?
+                .map_err(plot_error)?
                 .label(*name)
                 .legend(move |(x, y)| {
                     Rectangle::new([(x, y - 6), (x + 20, y + 6)], region.mix(0.45).filled())
@@ -1028,7 +1019,7 @@ where
             let c = CURVES[(k - 1) % CURVES.len()];
             chart
                 .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
-                .map_err(err)?
+                .map_err(plot_error)?
                 .label(*name)
                 .legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
@@ -1042,7 +1033,7 @@ where
                 7,
                 BLACK.stroke_width(2),
             )))
-            .map_err(err)?
+            .map_err(plot_error)?
             .label(name)
             .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
     }
@@ -1053,8 +1044,13 @@ where
         .border_style(BLACK.mix(0.4))
         .label_font(("sans-serif", 14))
         .draw()
-        .map_err(err)?;
-    root.present().map_err(err)
+        .map_err(plot_error)?;
+    root.present().map_err(plot_error)
+}
+
+/// A drawing backend's error as the plot's.
+pub(crate) fn plot_error<E: std::fmt::Debug>(e: E) -> IoError {
+    IoError::Plot(format!("{e:?}"))
 }
 
 #[cfg(test)]

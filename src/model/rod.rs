@@ -504,16 +504,6 @@ impl Clamps {
         c
     }
 
-    /// Halfway between two clamps (z*, δ, φ as the paper's bisections take it).
-    pub fn midpoint(&self, to: &Clamps) -> Clamps {
-        Clamps {
-            z_star: 0.5 * (self.z_star + to.z_star),
-            delta: 0.5 * (self.delta + to.delta),
-            phi: 0.5 * (self.phi + to.phi),
-            ..self.lerp(to, 0.5)
-        }
-    }
-
     /// Largest change of any scalar between two clamps (φ and turns in turns).
     pub fn gap(&self, to: &Clamps) -> f64 {
         let mut g = Parameter::ALL

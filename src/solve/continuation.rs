@@ -495,11 +495,9 @@ impl<'a> Tracer<'a> {
             },
         )?;
         let lo_value = b.holds.unwrap_or_else(|| self.parameter_of(&from.state));
-        let last = b.fails;
-        let hi = b.hi;
-        let point = match last {
+        let point = match b.fails {
             Some(p) => p,
-            None => self.correct(from, hi, None)?,
+            None => self.correct(from, b.hi, None)?,
         };
         Ok(Bracketed {
             within: (self.parameter_of(&point.state) - lo_value).abs(),

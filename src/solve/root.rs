@@ -164,9 +164,13 @@ impl Secant {
                 (Some(a), b, chord)
             }
         };
-        let mut visited: Vec<f64> = previous.iter().chain([&last]).map(|p| p.at).collect();
+        // the abscissae solved at, for the stall rule alone
+        let mut visited: Vec<f64> = match self.stall {
+            Some(_) => previous.iter().chain([&last]).map(|p| p.at).collect(),
+            None => Vec::new(),
+        };
         let mut last_root = f64::NAN;
-        let mut values = [previous.as_ref().map_or(f64::NAN, |p| p.value), last.value];
+        let mut evaluations = 0;
         let why = 'iterate: {
             for k in 0..=self.max_evaluations {
                 if last.value == 0.0 {
@@ -189,10 +193,7 @@ impl Secant {
                 let root = last.at + step;
                 let last_chord = previous.as_ref().map_or(0.0, |p| last.at - p.at);
                 if self.reach.reached(root, step, last_chord) {
-                    return Err(SecantFailure {
-                        why: NoRoot::Left(step),
-                        values,
-                    });
+                    break 'iterate NoRoot::Left(step);
                 }
                 // the predicted root's move: the step itself where each
                 // root is solved at, else the change of the extrapolation
@@ -224,8 +225,10 @@ impl Secant {
                 if dx.abs() > self.shortest_chord {
                     chord = (dx, next.value - last.value);
                 }
-                visited.push(next.at);
-                values = [last.value, next.value];
+                evaluations += 1;
+                if self.stall.is_some() {
+                    visited.push(next.at);
+                }
                 let done = (self.confirm && moved <= tolerance) || settled(&last, &next);
                 previous = Some(std::mem::replace(&mut last, next));
                 last_root = root;
@@ -243,8 +246,10 @@ impl Secant {
             NoRoot::NotConverged
         };
         // steps stalled at the test's noise (a root where it is flat): the
-        // last solution, its error the spread of the last abscissae
+        // last solution, its error the spread of the last abscissae (not
+        // for a step that left the neighbourhood)
         if let Some((count, spread)) = self.stall
+            && !matches!(why, NoRoot::Left(_))
             && visited.len() > count
         {
             let tail = &visited[visited.len() - count..];
@@ -261,10 +266,11 @@ impl Secant {
                     previous,
                     step,
                     error: hi - lo,
-                    iterations: visited.len(),
+                    iterations: evaluations,
                 });
             }
         }
+        let values = [previous.map_or(f64::NAN, |p| p.value), last.value];
         Err(SecantFailure { why, values })
     }
 }
