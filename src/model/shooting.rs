@@ -54,6 +54,57 @@ pub fn rhs_loaded(
     f
 }
 
+/// The derivative of [`rhs_loaded`] in the state at `y` along `delta`,
+/// exact ((A.2) is bilinear in the state).
+pub fn rhs_loaded_derivative(
+    y: &OdeState,
+    delta: &OdeState,
+    k2: f64,
+    k3: f64,
+    weight: &Vector3<f64>,
+    natural: &Vector3<f64>,
+) -> OdeState {
+    let (m, dm) = (part(y, 5), part(delta, 5));
+    let u = Vector3::new(m[0], m[1] / k2, m[2] / k3) + natural;
+    let du = Vector3::new(dm[0], dm[1] / k2, dm[2] / k3);
+    let mut f = OdeState::zeros();
+    for (k, v) in balance_derivative(y.as_slice(), &u, delta.as_slice(), &du, weight)
+        .iter()
+        .enumerate()
+    {
+        f.fixed_rows_mut::<3>(3 * k).copy_from(v);
+    }
+    f[18] = du[2];
+    f
+}
+
+/// The rates r', d1', d2', d3', n', m' of (A.2) with strains u and a body
+/// force `weight` (lab frame), differentiated along a perturbation `delta`
+/// of the state (r, d1, d2, d3, n, m first, as `y`) and `du` of the strains:
+/// the variational equations the rod and the strip share.
+pub fn balance_derivative(
+    y: &[f64],
+    u: &Vector3<f64>,
+    delta: &[f64],
+    du: &Vector3<f64>,
+    weight: &Vector3<f64>,
+) -> [Vector3<f64>; 6] {
+    let at = |v: &[f64], k: usize| Vector3::new(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
+    let (d1, d2, d3) = (at(y, 1), at(y, 2), at(y, 3));
+    let (e1, e2, e3) = (at(delta, 1), at(delta, 2), at(delta, 3));
+    let (n, m) = (at(y, 4), at(y, 5));
+    let (dn, dm) = (at(delta, 4), at(delta, 5));
+    let load = Vector3::new(weight.dot(&e1), weight.dot(&e2), weight.dot(&e3));
+    [
+        e3,
+        u[2] * e2 + du[2] * d2 - u[1] * e3 - du[1] * d3,
+        u[0] * e3 + du[0] * d3 - u[2] * e1 - du[2] * d1,
+        u[1] * e1 + du[1] * d1 - u[0] * e2 - du[0] * d2,
+        dn.cross(u) + n.cross(du) - load,
+        dm.cross(u) + m.cross(du) + Vector3::new(dn[1], -dn[0], 0.0),
+    ]
+}
+
 /// A solution of (A.2) on [0, 1], integrated to [`REFERENCE_TOLERANCE`] and
 /// sampled on a uniform grid (the integrator's dense output).
 #[derive(Clone, Debug)]
@@ -263,4 +314,33 @@ pub fn start_frame(clamps: &Clamps) -> OdeState {
         }
     }
     y
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::SMatrix;
+
+    #[test]
+    fn the_variational_equations_are_the_right_hand_sides_derivative() {
+        let (k2, k3) = (2.5, 0.7);
+        let weight = Vector3::new(0.3, -1.2, 0.8);
+        let natural = Vector3::new(0.4, -0.3, 0.2);
+        let f = |y: &OdeState| rhs_loaded(y, k2, k3, &weight, &natural);
+        for t in [0.3, 1.1, 2.9] {
+            let y = OdeState::from_fn(|i, _| ((i as f64 + 0.4) * t).sin() * 3.0);
+            let mut exact = SMatrix::<f64, 19, 19>::zeros();
+            let mut fd = SMatrix::<f64, 19, 19>::zeros();
+            for c in 0..19 {
+                let mut e = OdeState::zeros();
+                e[c] = 1.0;
+                exact.set_column(c, &rhs_loaded_derivative(&y, &e, k2, k3, &weight, &natural));
+                // a central difference is exact for a quadratic, up to round-off
+                let h = 1e-3;
+                fd.set_column(c, &((f(&(y + h * e)) - f(&(y - h * e))) / (2.0 * h)));
+            }
+            let err = (exact - fd).norm() / exact.norm();
+            assert!(err < 1e-12, "relative difference {err:.1e}");
+        }
+    }
 }

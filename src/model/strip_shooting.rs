@@ -16,8 +16,7 @@
 //! the rod solver; its start values come from a DER strip equilibrium
 //! ([`StripUnknowns::from_der`]).
 
-use crate::linalg::jet;
-use crate::model::energy::{RodEnergy, strip_energy, vertex_strains};
+use crate::model::energy::{RodEnergy, vertex_strains};
 use crate::model::natural::NaturalStrains;
 use crate::model::ode::{
     IntegrationError, REFERENCE_TOLERANCE, hermite, integrate, integrate_stops,
@@ -71,14 +70,34 @@ pub enum StripShootingError {
 }
 
 /// The Sadowsky density W(a, u3) of the DER (`strip_energy` at h = 1): its
-/// gradient (m1, m3) and Hessian.
+/// gradient (m1, m3) and Hessian, in closed form (W = S²/2D with S = a² + u3²,
+/// D = a² + ε²; tested against the DER's density differentiated by jets).
 pub fn sadowsky(a: f64, u3: f64, regularisation: f64) -> (Vector2<f64>, Matrix2<f64>) {
-    let (_, g, h) =
-        jet::hessian::<2, 3>([a, u3], |v| strip_energy(v[0], v[1], regularisation, 1.0));
-    (
-        Vector2::new(g[0], g[1]),
-        Matrix2::new(h[0][0], h[0][1], h[1][0], h[1][1]),
-    )
+    let (a2, u2, e2) = (a * a, u3 * u3, regularisation * regularisation);
+    let (s, d) = (a2 + u2, a2 + e2);
+    let gradient = Vector2::new(a * s * (a2 + 2.0 * e2 - u2) / (d * d), 2.0 * u3 * s / d);
+    let w_aa = (a2 * a2 * a2 + 3.0 * a2 * a2 * e2 + 6.0 * a2 * e2 * e2 - 6.0 * a2 * e2 * u2
+        + 3.0 * a2 * u2 * u2
+        + 2.0 * e2 * e2 * u2
+        - e2 * u2 * u2)
+        / (d * d * d);
+    let w_au = -4.0 * a * u3 * (u2 - e2) / (d * d);
+    let w_uu = 2.0 * (a2 + 3.0 * u2) / d;
+    (gradient, Matrix2::new(w_aa, w_au, w_au, w_uu))
+}
+
+/// The Sadowsky density's third derivatives (W_aaa, W_aau, W_auu, W_uuu):
+/// how the Hessian of (4.3) moves with the strains, for the strip's
+/// variational equations.
+pub fn sadowsky_third(a: f64, u3: f64, regularisation: f64) -> [f64; 4] {
+    let (a2, u2, e2) = (a * a, u3 * u3, regularisation * regularisation);
+    let d = a2 + e2;
+    [
+        -12.0 * a * (a2 - e2) * (u2 - e2) * (u2 - e2) / (d * d * d * d),
+        4.0 * u3 * (3.0 * a2 - e2) * (u2 - e2) / (d * d * d),
+        -4.0 * a * (3.0 * u2 - e2) / (d * d),
+        12.0 * u3 / d,
+    ]
 }
 
 /// The paper's six shooting unknowns of the strip at s = 0 (Sec. 4):
@@ -136,31 +155,112 @@ pub fn strip_rhs(
     weight: &Vector3<f64>,
     natural: &NaturalStrains,
 ) -> StripOdeState {
+    let u = Vector3::new(y[A] + natural.at(s)[0], 0.0, y[U3]);
+    let mut f = balance(y, &u, weight);
+    // (4.3): the law's moments follow m1' and m3' through its Hessian
+    let (_, h) = sadowsky(y[A], y[U3], regularisation);
+    let du = inverse_law(&h) * Vector2::new(f[15], f[17]);
+    f[A] = du[0];
+    f[U3] = du[1];
+    f
+}
+
+/// The frame, force and moment equations of (A.2) with u = (u1, 0, u3),
+/// and ∫u3 ds: every rate but the strains'.
+fn balance(y: &StripOdeState, u: &Vector3<f64>, weight: &Vector3<f64>) -> StripOdeState {
     let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
-    let n = part(y, 4);
-    let m = part(y, 5);
-    let (a, u3) = (y[A], y[U3]);
-    let u = Vector3::new(a + natural.at(s)[0], 0.0, u3);
+    let (n, m) = (part(y, 4), part(y, 5));
     let mut f = StripOdeState::zeros();
     set(&mut f, 0, d3);
     set(&mut f, 1, u[2] * d2 - u[1] * d3);
     set(&mut f, 2, u[0] * d3 - u[2] * d1);
     set(&mut f, 3, u[1] * d1 - u[0] * d2);
     let load = Vector3::new(weight.dot(&d1), weight.dot(&d2), weight.dot(&d3));
-    let dn = n.cross(&u) - load;
-    let dm = m.cross(&u) + Vector3::new(n[1], -n[0], 0.0);
-    set(&mut f, 4, dn);
-    set(&mut f, 5, dm);
-    // (4.3): the law's moments follow m1' and m3' through its Hessian
-    let (_, h) = sadowsky(a, u3, regularisation);
-    let du = h
-        .lu()
-        .solve(&Vector2::new(dm[0], dm[2]))
-        .unwrap_or_else(|| Vector2::repeat(f64::NAN));
-    f[A] = du[0];
-    f[U3] = du[1];
-    f[TWIST] = u3;
+    set(&mut f, 4, n.cross(u) - load);
+    set(&mut f, 5, m.cross(u) + Vector3::new(n[1], -n[0], 0.0));
+    f[TWIST] = u[2];
     f
+}
+
+/// H⁻¹ of (4.3), (a', u3') = H⁻¹ (m1', m3'); NaN where the law's Hessian
+/// is singular (the integration then stops as not finite).
+fn inverse_law(h: &Matrix2<f64>) -> Matrix2<f64> {
+    h.try_inverse().unwrap_or(Matrix2::repeat(f64::NAN))
+}
+
+/// The strip ODE's right-hand side at one (s, y) with what its derivative
+/// in y needs: the strip's variational equations, exact (the law's third
+/// derivatives move its Hessian in (4.3)).
+#[derive(Clone, Debug)]
+pub struct StripRhs {
+    /// y' at (s, y).
+    pub value: StripOdeState,
+    state: StripOdeState,
+    strains: Vector3<f64>,
+    weight: Vector3<f64>,
+    inverse_hessian: Matrix2<f64>,
+    third: [f64; 4],
+}
+
+impl StripRhs {
+    /// The right-hand side of [`strip_rhs`] at (s, y) and its linearisation
+    /// there.
+    pub fn at(
+        s: f64,
+        y: &StripOdeState,
+        regularisation: f64,
+        weight: &Vector3<f64>,
+        natural: &NaturalStrains,
+    ) -> Self {
+        let strains = Vector3::new(y[A] + natural.at(s)[0], 0.0, y[U3]);
+        let mut value = balance(y, &strains, weight);
+        let (_, h) = sadowsky(y[A], y[U3], regularisation);
+        let inverse_hessian = inverse_law(&h);
+        let du = inverse_hessian * Vector2::new(value[15], value[17]);
+        value[A] = du[0];
+        value[U3] = du[1];
+        StripRhs {
+            value,
+            state: *y,
+            strains,
+            weight: *weight,
+            inverse_hessian,
+            third: sadowsky_third(y[A], y[U3], regularisation),
+        }
+    }
+
+    /// The right-hand side's derivative in y along `delta`.
+    pub fn derivative(&self, delta: &StripOdeState) -> StripOdeState {
+        let (y, u, w) = (&self.state, &self.strains, &self.weight);
+        let du = Vector3::new(delta[A], 0.0, delta[U3]);
+        let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
+        let (e1, e2, e3) = (part(delta, 1), part(delta, 2), part(delta, 3));
+        let (n, m) = (part(y, 4), part(y, 5));
+        let (dn, dm) = (part(delta, 4), part(delta, 5));
+        let mut f = StripOdeState::zeros();
+        set(&mut f, 0, e3);
+        set(&mut f, 1, u[2] * e2 + du[2] * d2 - u[1] * e3 - du[1] * d3);
+        set(&mut f, 2, u[0] * e3 + du[0] * d3 - u[2] * e1 - du[2] * d1);
+        set(&mut f, 3, u[1] * e1 + du[1] * d1 - u[0] * e2 - du[0] * d2);
+        let load = Vector3::new(w.dot(&e1), w.dot(&e2), w.dot(&e3));
+        set(&mut f, 4, dn.cross(u) + n.cross(&du) - load);
+        set(
+            &mut f,
+            5,
+            dm.cross(u) + m.cross(&du) + Vector3::new(dn[1], -dn[0], 0.0),
+        );
+        f[TWIST] = du[2];
+        // H (a', u3')ᵀ = (m1', m3')ᵀ differentiated: H δ(a', u3') + δH (a', u3') = δ(m1', m3')
+        let [w_aaa, w_aau, w_auu, w_uuu] = self.third;
+        let (x, z) = (delta[A], delta[U3]);
+        let off = w_aau * x + w_auu * z;
+        let dh = Matrix2::new(w_aaa * x + w_aau * z, off, off, w_auu * x + w_uuu * z);
+        let rates = Vector2::new(self.value[A], self.value[U3]);
+        let d_rates = self.inverse_hessian * (Vector2::new(f[15], f[17]) - dh * rates);
+        f[A] = d_rates[0];
+        f[U3] = d_rates[1];
+        f
+    }
 }
 
 /// A solution of the strip ODE on [0, 1], integrated to
@@ -309,6 +409,81 @@ impl StripProblem {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::jet;
+    use crate::model::energy::strip_energy;
+    use nalgebra::SMatrix;
+
+    /// States of the strip with every component in play, a weight and a
+    /// varying natural curvature.
+    fn samples() -> Vec<(f64, StripOdeState, f64)> {
+        (0..6)
+            .map(|k| {
+                let t = k as f64;
+                let y = StripOdeState::from_fn(|i, _| ((i as f64 + 1.3) * (t + 0.7)).sin());
+                (0.1 + 0.15 * t, y, [0.0, 0.02, 0.3][k % 3])
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_closed_form_law_is_the_ders_density_differentiated() {
+        for (_, y, eps) in samples() {
+            let (a, u3) = (y[A], y[U3]);
+            let (_, g, h) = jet::hessian::<2, 3>([a, u3], |v| strip_energy(v[0], v[1], eps, 1.0));
+            let (m, hh) = sadowsky(a, u3, eps);
+            let scale = 1.0 + g[0].abs().max(g[1].abs());
+            assert!(
+                (m - Vector2::new(g[0], g[1])).norm() < 1e-13 * scale,
+                "{m} {g:?}"
+            );
+            let dense = Matrix2::new(h[0][0], h[0][1], h[1][0], h[1][1]);
+            assert!(
+                (hh - dense).norm() < 1e-12 * (1.0 + dense.norm()),
+                "{hh} {dense}"
+            );
+            // the third derivatives: central differences of the Hessian
+            let [w_aaa, w_aau, w_auu, w_uuu] = sadowsky_third(a, u3, eps);
+            let step = 1e-5;
+            let da = (sadowsky(a + step, u3, eps).1 - sadowsky(a - step, u3, eps).1) / (2.0 * step);
+            let du = (sadowsky(a, u3 + step, eps).1 - sadowsky(a, u3 - step, eps).1) / (2.0 * step);
+            let exact_a = Matrix2::new(w_aaa, w_aau, w_aau, w_auu);
+            let exact_u = Matrix2::new(w_aau, w_auu, w_auu, w_uuu);
+            for (fd, exact) in [(da, exact_a), (du, exact_u)] {
+                let err = (fd - exact).norm() / (1.0 + exact.norm());
+                assert!(err < 1e-7, "{fd} against {exact}: {err:.1e}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_variational_equations_are_the_right_hand_sides_derivative() {
+        let weight = Vector3::new(0.3, -0.7, 1.1);
+        let natural = NaturalStrains::Constant([0.4, 0.0, 0.0]);
+        for (s, y, eps) in samples() {
+            let rhs = StripRhs::at(s, &y, eps, &weight, &natural);
+            assert_eq!(rhs.value, strip_rhs(s, &y, eps, &weight, &natural));
+            let mut jacobian = SMatrix::<f64, 21, 21>::zeros();
+            let mut fd = SMatrix::<f64, 21, 21>::zeros();
+            for c in 0..21 {
+                let mut e = StripOdeState::zeros();
+                e[c] = 1.0;
+                jacobian.set_column(c, &rhs.derivative(&e));
+                let h = 1e-6;
+                let f = |y: &StripOdeState| strip_rhs(s, y, eps, &weight, &natural);
+                fd.set_column(c, &((f(&(y + h * e)) - f(&(y - h * e))) / (2.0 * h)));
+            }
+            let err = (jacobian - fd).norm() / jacobian.norm();
+            assert!(
+                err < 1e-8,
+                "at s = {s}, ε = {eps}: relative difference {err:.1e}"
+            );
+            // linear in the direction
+            let (e, f) = (y.map(|v| v.cos()), y.map(|v| (2.0 * v).sin()));
+            let sum = rhs.derivative(&(2.0 * e - f));
+            let parts = 2.0 * rhs.derivative(&e) - rhs.derivative(&f);
+            assert!((sum - parts).norm() < 1e-12 * (1.0 + sum.norm()));
+        }
+    }
 
     #[test]
     fn the_law_is_the_papers_at_zero_regularisation() {

@@ -387,8 +387,8 @@ pub(crate) fn locate_root(
     let fine_branch = branch.with_tolerance(branch.tolerance * 1e-2);
     let step = (10.0 * coarse.last_step.abs()).max(1e-8 * scale);
     let fine = fine_branch.locate(coarse.point, held, step, resolution, coarse.test.clone())?;
-    let error = (coarse.point[PARAMETER] - fine.point[PARAMETER]).abs()
-        + (fine.point[PARAMETER] - fine.previous[PARAMETER]).abs();
+    let error =
+        (coarse.point[PARAMETER] - fine.point[PARAMETER]).abs() + fine.parameter_error(held);
     Ok(Root {
         error,
         steps: coarse.steps + fine.steps,

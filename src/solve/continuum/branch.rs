@@ -162,6 +162,22 @@ pub struct Located {
     pub previous: BranchPoint,
 }
 
+impl Located {
+    /// The error of the located parameter value. Along the parameter, the
+    /// secant's next step, too small to take (the root's distance from the
+    /// last point solved at, to the order of the step before it squared):
+    /// not the gap to the point before, which is the error of that point
+    /// and so grows the faster the iteration converged. Along an unknown
+    /// held at a fold, the parameter's last change (stationary there).
+    pub fn parameter_error(&self, held: usize) -> f64 {
+        if held == PARAMETER {
+            self.last_step.abs()
+        } else {
+            (self.point[PARAMETER] - self.previous[PARAMETER]).abs()
+        }
+    }
+}
+
 impl<'a> ContinuumBranch<'a> {
     /// The branch of `model` through `clamps` in `parameter`, integrated to
     /// `tolerance`.
@@ -227,9 +243,10 @@ impl<'a> ContinuumBranch<'a> {
         // integrations fewer, and free of the integrator's noise)
         let at = |value: f64| -> Result<Vector6<f64>, BranchError> {
             let problem = self.problem(value)?;
-            Ok(match &end {
-                Some(y) if self.parameter.moves_end_only() => problem.residual_of_end(y),
-                _ => problem.residual(&p)?,
+            Ok(if self.parameter.moves_end_only() {
+                problem.residual_of_end(&end)
+            } else {
+                problem.residual(&p)?
             })
         };
         let (plus, minus) = (at(z[PARAMETER] + h)?, at(z[PARAMETER] - h)?);

@@ -23,15 +23,17 @@ use crate::model::energy::strip_energy;
 use crate::model::natural::NaturalStrains;
 use crate::model::ode::{Integrated, IntegrationError, integrate, integrate_stops};
 use crate::model::rod::{Clamps, EndKind, Law, RodModel};
-use crate::model::shooting::{OdeState, end_conditions, rhs_loaded, start_frame};
-use crate::model::strip_shooting::{StripOdeState, sadowsky, strip_rhs};
-use crate::solve::continuum::newton::{NewtonShootingFailure, central_jacobian, newton_shooting};
+use crate::model::shooting::{
+    OdeState, end_conditions, rhs_loaded, rhs_loaded_derivative, start_frame,
+};
+use crate::model::strip_shooting::{StripOdeState, StripRhs, sadowsky, strip_rhs};
+use crate::solve::continuum::newton::{NewtonShootingFailure, newton_shooting};
 use nalgebra::{Matrix6, SVector, Vector3, Vector6};
 use std::f64::consts::PI;
 
-/// The s = 1 residual, its Jacobian in the unknowns, and the rod's state at
-/// s = 1 they came from (None for a strip).
-pub(crate) type Linearised = (Vector6<f64>, Matrix6<f64>, Option<OdeState>);
+/// The s = 1 residual, its Jacobian in the unknowns, and the state at s = 1
+/// they came from (r, d1, d2, d3, n, m, ∫u3: a strip's strains left out).
+pub(crate) type Linearised = (Vector6<f64>, Matrix6<f64>, OdeState);
 
 /// Why a continuum solution could not be made.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -137,6 +139,8 @@ const ROD: usize = 21;
 const STRIP: usize = 23;
 // the rod's state (A.2) and its derivatives in the six unknowns
 pub(crate) const VARIATIONAL: usize = 19 * 7;
+// the strip's state and its derivatives in the six unknowns
+pub(crate) const STRIP_VARIATIONAL: usize = 21 * 7;
 
 fn check_finite(p: &Unknowns) -> Result<(), ContinuumError> {
     match p.iter().position(|v| !v.is_finite()) {
@@ -262,6 +266,59 @@ impl Continuum {
         (y0, m0)
     }
 
+    /// The strip's state at s = 0 and its derivatives in the six unknowns
+    /// n(0), u1(0), m2(0), u3(0): m1(0), m3(0) follow u1(0), u3(0) through
+    /// the law's gradient, so their derivatives are its Hessian.
+    pub(crate) fn strip_variational_start(
+        &self,
+        p: &Unknowns,
+        regularisation: f64,
+    ) -> SVector<f64, STRIP_VARIATIONAL> {
+        let mut y0 = SVector::<f64, STRIP_VARIATIONAL>::zeros();
+        y0.fixed_rows_mut::<21>(0)
+            .copy_from(&self.strip_start(p, regularisation).0.fixed_rows::<21>(0));
+        let (_, h) = sadowsky(y0[18], y0[19], regularisation);
+        for c in 0..3 {
+            y0[21 * (c + 1) + 12 + c] = 1.0;
+        }
+        // u1(0) moves a(0), m1(0) and m3(0); m2(0) itself; u3(0) likewise
+        for (c, strain, column) in [(3, 18, 0), (5, 19, 1)] {
+            let block = 21 * (c + 1);
+            y0[block + strain] = 1.0;
+            y0[block + 15] = h[(0, column)];
+            y0[block + 17] = h[(1, column)];
+        }
+        y0[21 * 5 + 16] = 1.0;
+        y0
+    }
+
+    /// The strip's equations and their exact linearisation along six
+    /// perturbations; with `lambda` = ω² each n̄_i' gains −ω² r̄·d_i (A.4).
+    pub(crate) fn strip_variational_rhs(
+        &self,
+        s: f64,
+        y: &SVector<f64, STRIP_VARIATIONAL>,
+        regularisation: f64,
+        lambda: f64,
+    ) -> SVector<f64, STRIP_VARIATIONAL> {
+        let core: StripOdeState = y.fixed_rows::<21>(0).into();
+        let rhs = StripRhs::at(s, &core, regularisation, &self.weight, &self.natural);
+        let mut dy = SVector::<f64, STRIP_VARIATIONAL>::zeros();
+        dy.fixed_rows_mut::<21>(0).copy_from(&rhs.value);
+        for c in 1..7 {
+            let delta: StripOdeState = y.fixed_rows::<21>(21 * c).into();
+            let mut jd = rhs.derivative(&delta);
+            if lambda != 0.0 {
+                let r = part(&delta, 0);
+                for i in 0..3 {
+                    jd[12 + i] -= lambda * r.dot(&part(&core, 1 + i));
+                }
+            }
+            dy.fixed_rows_mut::<21>(21 * c).copy_from(&jd);
+        }
+        dy
+    }
+
     /// The strip's right-hand side with the energy density and the weight's
     /// potential alongside.
     fn strip_rhs(
@@ -339,37 +396,43 @@ impl Continuum {
     /// Jacobian comes from the variational equations integrated with the
     /// solution (the right-hand side of (A.2) is quadratic in the state, so
     /// its directional derivative is an exact central difference); for a
-    /// strip, from central differences of whole integrations.
+    /// strip likewise, its linearisation exact through the law's third
+    /// derivatives (`StripRhs`).
     pub fn linearise(&self, p: &Unknowns) -> Result<(Vector6<f64>, Matrix6<f64>), ContinuumError> {
         self.linearise_to_end(p).map(|(r, jac, _)| (r, jac))
     }
 
-    /// [`Self::linearise`], with the rod's state at s = 1 it came from (None
-    /// for a strip): the residual under other s = 1 clamps is
+    /// [`Self::linearise`], with the state at s = 1 it came from: the
+    /// residual under other s = 1 clamps is
     /// [`Self::residual_of_end`] of it, no integration.
     pub(crate) fn linearise_to_end(&self, p: &Unknowns) -> Result<Linearised, ContinuumError> {
         check_finite(p)?;
-        let ContinuumLaw::Kirchhoff { k2, k3 } = self.law else {
-            let r = self.residual(p)?;
-            let res = |q: &Unknowns| {
-                self.residual(q)
-                    .unwrap_or_else(|_| Vector6::repeat(f64::NAN))
-            };
-            let jac = central_jacobian(p, res);
-            if jac.iter().any(|v| !v.is_finite()) {
-                return Err(ContinuumError::Singular);
+        // the end state and its six derivatives as r, d1, d2, d3, n, m, ∫u3
+        let (core, deltas): (OdeState, [OdeState; 6]) = match self.law {
+            ContinuumLaw::Kirchhoff { k2, k3 } => {
+                let y0 = self.variational_start(p);
+                let f =
+                    |s: f64, y: &SVector<f64, VARIATIONAL>| self.variational_rhs(s, y, k2, k3, 0.0);
+                let end = integrate_stops(y0, f, self.tolerance, &[1.0])?.0[0];
+                let cut = |k: usize| -> OdeState { end.fixed_rows::<19>(19 * k).into() };
+                (cut(0), std::array::from_fn(|c| cut(c + 1)))
             }
-            return Ok((r, jac, None));
+            ContinuumLaw::Strip { regularisation } => {
+                let y0 = self.strip_variational_start(p, regularisation);
+                let f = |s: f64, y: &SVector<f64, STRIP_VARIATIONAL>| {
+                    self.strip_variational_rhs(s, y, regularisation, 0.0)
+                };
+                let end = integrate_stops(y0, f, self.tolerance, &[1.0])?.0[0];
+                // the strip's a and u3 (18, 19) have no place in the rod's state
+                let cut =
+                    |k: usize| OdeState::from_fn(|i, _| end[21 * k + if i < 18 { i } else { 20 }]);
+                (cut(0), std::array::from_fn(|c| cut(c + 1)))
+            }
         };
-        let y0 = self.variational_start(p);
-        let f = |s: f64, y: &SVector<f64, VARIATIONAL>| self.variational_rhs(s, y, k2, k3, 0.0);
-        let end = integrate_stops(y0, f, self.tolerance, &[1.0])?.0[0];
-        let core: OdeState = end.fixed_rows::<19>(0).into();
         let residual_of = |y: &OdeState| self.residual_of_end(y);
         let r = residual_of(&core);
         let mut jac = Matrix6::zeros();
-        for c in 0..6 {
-            let delta: OdeState = end.fixed_rows::<19>(19 * (c + 1)).into();
+        for (c, delta) in deltas.iter().enumerate() {
             // the s = 1 conditions are smooth functions of the end state:
             // their derivative along ∂y(1)/∂p_c by central differences
             let h = 1e-6 / delta.norm().max(1e-300);
@@ -380,7 +443,7 @@ impl Continuum {
         if jac.iter().any(|v| !v.is_finite()) {
             return Err(ContinuumError::Singular);
         }
-        Ok((r, jac, Some(core)))
+        Ok((r, jac, core))
     }
 
     /// The s = 1 conditions of this problem's clamps on a rod's state at
@@ -416,17 +479,13 @@ impl Continuum {
         lambda: f64,
     ) -> SVector<f64, VARIATIONAL> {
         let natural = self.natural.vector_at(s);
-        let rhs = |y: &OdeState| rhs_loaded(y, k2, k3, &self.weight, &natural);
         let core: OdeState = y.fixed_rows::<19>(0).into();
         let mut dy = SVector::<f64, VARIATIONAL>::zeros();
-        dy.fixed_rows_mut::<19>(0).copy_from(&rhs(&core));
+        dy.fixed_rows_mut::<19>(0)
+            .copy_from(&rhs_loaded(&core, k2, k3, &self.weight, &natural));
         for c in 1..7 {
             let delta: OdeState = y.fixed_rows::<19>(19 * c).into();
-            // exact for a quadratic right-hand side at any scale of δ;
-            // the scale keeps round-off relative to |y|
-            let scale = 1.0 / delta.norm().max(1.0);
-            let mut jd =
-                (rhs(&(core + scale * delta)) - rhs(&(core - scale * delta))) / (2.0 * scale);
+            let mut jd = rhs_loaded_derivative(&core, &delta, k2, k3, &self.weight, &natural);
             if lambda != 0.0 {
                 let r = part(&delta, 0);
                 for i in 0..3 {
@@ -515,6 +574,7 @@ impl Continuum {
 mod tests {
     use super::*;
     use crate::model::shooting::ShootingSolution;
+    use crate::solve::continuum::newton::central_jacobian;
     use crate::solve::continuum::shooting::refine_shooting;
 
     fn appendix_d() -> (Continuum, Unknowns) {
@@ -591,6 +651,27 @@ mod tests {
         c.natural = NaturalStrains::Constant([0.4, -0.3, 0.2]);
         let (r, jac) = c.linearise(&p).unwrap();
         assert!((r - c.residual(&p).unwrap()).norm() < 1e-10);
+        let fd = central_jacobian(&p, |q| c.residual(q).unwrap());
+        let err = (jac - fd).norm() / jac.norm();
+        assert!(err < 1e-7, "relative difference {err:.2e}");
+    }
+
+    #[test]
+    fn the_strips_variational_jacobian_is_the_difference_quotient() {
+        // a strip with weight and natural curvature, away from equilibrium
+        let c = Continuum {
+            law: ContinuumLaw::Strip {
+                regularisation: 0.02,
+            },
+            weight: Vector3::new(0.4, 0.1, -0.8),
+            natural: NaturalStrains::Constant([0.5, 0.0, 0.0]),
+            clamps: Clamps::new(0.1, 0.05, 0.9),
+            tolerance: 1e-12,
+        };
+        let p = Unknowns::new(0.3, -0.2, 0.5, 4.0 * PI, 0.1, 0.4);
+        let (r, jac, end) = c.linearise_to_end(&p).unwrap();
+        assert!((r - c.residual(&p).unwrap()).norm() < 1e-10);
+        assert!((c.residual_of_end(&end) - r).norm() < 1e-14);
         let fd = central_jacobian(&p, |q| c.residual(q).unwrap());
         let err = (jac - fd).norm() / jac.norm();
         assert!(err < 1e-7, "relative difference {err:.2e}");

@@ -12,8 +12,9 @@
 
 use crate::model::ode::integrate_stops;
 use crate::model::rod::EndKind;
-use crate::model::strip_shooting::{StripOdeState, strip_rhs};
-use crate::solve::continuum::{Continuum, ContinuumError, ContinuumLaw, Unknowns, VARIATIONAL};
+use crate::solve::continuum::{
+    Continuum, ContinuumError, ContinuumLaw, STRIP_VARIATIONAL, Unknowns, VARIATIONAL,
+};
 use nalgebra::{Matrix6, SVector, Vector3};
 
 /// Samples of det B(s) in (0, 1] counted for sign changes.
@@ -33,9 +34,6 @@ pub struct ContinuumSpectrum {
     /// Each one's error: its change at a 100 times looser tolerance.
     pub errors: Vec<f64>,
 }
-
-/// The strip's state then its derivatives in the six unknowns.
-const STRIP_VARIATIONAL: usize = 21 * 7;
 
 fn part(y: &[f64], k: usize) -> Vector3<f64> {
     Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
@@ -97,59 +95,6 @@ impl Continuum {
             }
         };
         Ok(dets)
-    }
-
-    /// The strip's state at s = 0 and its derivatives in the six unknowns
-    /// n(0), u1(0), m2(0), u3(0) (central differences: m1(0), m3(0) follow
-    /// u1(0), u3(0) through the law).
-    fn strip_variational_start(
-        &self,
-        p: &Unknowns,
-        regularisation: f64,
-    ) -> SVector<f64, STRIP_VARIATIONAL> {
-        let mut y0 = SVector::<f64, STRIP_VARIATIONAL>::zeros();
-        let start = |q: &Unknowns| self.strip_start(q, regularisation).0;
-        y0.fixed_rows_mut::<21>(0)
-            .copy_from(&start(p).fixed_rows::<21>(0));
-        for c in 0..6 {
-            let h = 1e-6 * p[c].abs().max(1.0);
-            let mut q = *p;
-            q[c] += h;
-            let plus = start(&q);
-            q[c] -= 2.0 * h;
-            let minus = start(&q);
-            for k in 0..21 {
-                y0[21 * (c + 1) + k] = (plus[k] - minus[k]) / (2.0 * h);
-            }
-        }
-        y0
-    }
-
-    /// The strip's equations and their linearisation along six
-    /// perturbations (central differences at a relative step of 1e-6; the
-    /// law is not quadratic), each n̄_i' with −ω² r̄·d_i.
-    fn strip_variational_rhs(
-        &self,
-        s: f64,
-        y: &SVector<f64, STRIP_VARIATIONAL>,
-        regularisation: f64,
-        lambda: f64,
-    ) -> SVector<f64, STRIP_VARIATIONAL> {
-        let rhs = |y: &StripOdeState| strip_rhs(s, y, regularisation, &self.weight, &self.natural);
-        let core: StripOdeState = y.fixed_rows::<21>(0).into();
-        let mut dy = SVector::<f64, STRIP_VARIATIONAL>::zeros();
-        dy.fixed_rows_mut::<21>(0).copy_from(&rhs(&core));
-        for c in 1..7 {
-            let delta: StripOdeState = y.fixed_rows::<21>(21 * c).into();
-            let h = 1e-6 * core.norm().max(1.0) / delta.norm().max(1e-300);
-            let mut jd = (rhs(&(core + h * delta)) - rhs(&(core - h * delta))) / (2.0 * h);
-            let r = part(delta.as_slice(), 0);
-            for i in 0..3 {
-                jd[12 + i] -= lambda * r.dot(&part(core.as_slice(), 1 + i));
-            }
-            dy.fixed_rows_mut::<21>(21 * c).copy_from(&jd);
-        }
-        dy
     }
 
     /// The shooting determinant D(ω²) = det B(1): zero at an eigenvalue.

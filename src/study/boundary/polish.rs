@@ -432,16 +432,17 @@ impl Plane<'_> {
                 branch.locate(z, held, 1e-4 * scale, resolution * scale, ta.clone())
             };
             // as in root_on: at a fold of the line an unknown is held
-            let located = match along(PARAMETER) {
-                Ok(located) => located,
+            let (located, held) = match along(PARAMETER) {
+                Ok(located) => (located, PARAMETER),
                 Err(e) if matches!(ta, TestFunction::Singular { .. }) => {
-                    along(fold_held(&branch, &z).map_err(|_| e)?)?
+                    let held = fold_held(&branch, &z).map_err(|_| e)?;
+                    (along(held)?, held)
                 }
                 Err(e) => return Err(e.into()),
             };
             let (tb, gb) = branch.evaluate(&located.point, tb)?;
             q[free] = located.point[PARAMETER];
-            let error = (located.point[PARAMETER] - located.previous[PARAMETER]).abs();
+            let error = located.parameter_error(held);
             Ok::<_, PolishError>((
                 Polished {
                     at: q,

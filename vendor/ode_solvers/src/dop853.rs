@@ -281,6 +281,13 @@ where
         self.solution_output(y_tmp);
 
         let mut k = vec![OVector::zeros_generic(rows, cols); 12];
+        // knotrod: the stages' sums formed in place (axpy) in vectors made
+        // once, not in a temporary per term; the same operations in the
+        // same order, so the same bits
+        let mut y_next = OVector::zeros_generic(rows, cols);
+        let mut err_est = OVector::zeros_generic(rows, cols);
+        let mut err_bhh = OVector::zeros_generic(rows, cols);
+        let mut sum = OVector::zeros_generic(rows, cols);
         self.f.system(self.x, &self.y, &mut k[0]);
         self.stats.num_eval += 1;
 
@@ -311,11 +318,10 @@ where
             n_step += 1;
 
             // 12 Stages
-            let mut y_next = OVector::zeros_generic(rows, cols);
             for s in 1..12 {
-                y_next = self.y.clone();
+                y_next.copy_from(&self.y);
                 for (j, k_value) in k.iter().enumerate().take(s) {
-                    y_next += k_value * (self.h * dopri853::a::<T>(s + 1, j + 1));
+                    y_next.axpy(self.h * dopri853::a::<T>(s + 1, j + 1), k_value, T::one());
                 }
                 self.f.system(
                     self.x + (self.h * dopri853::c::<T>(s + 1)),
@@ -323,33 +329,33 @@ where
                     &mut k[s],
                 );
             }
-            k[1] = k[10].clone();
-            k[2] = k[11].clone();
+            let (head, tail) = k.split_at_mut(10);
+            head[1].copy_from(&tail[0]);
+            head[2].copy_from(&tail[1]);
             self.stats.num_eval += 11;
 
-            k[3] = &k[0] * dopri853::b::<T>(1)
-                + &k[5] * dopri853::b::<T>(6)
-                + &k[6] * dopri853::b::<T>(7)
-                + &k[7] * dopri853::b::<T>(8)
-                + &k[8] * dopri853::b::<T>(9)
-                + &k[9] * dopri853::b::<T>(10)
-                + &k[1] * dopri853::b::<T>(11)
-                + &k[2] * dopri853::b::<T>(12);
-            k[4] = &self.y + &k[3] * self.h;
+            sum.axpy(dopri853::b::<T>(1), &k[0], T::zero());
+            for (j, b) in [(5, 6), (6, 7), (7, 8), (8, 9), (9, 10), (1, 11), (2, 12)] {
+                sum.axpy(dopri853::b::<T>(b), &k[j], T::one());
+            }
+            std::mem::swap(&mut k[3], &mut sum);
+            k[4].copy_from(&self.y);
+            let (head, tail) = k.split_at_mut(4);
+            tail[0].axpy(self.h, &head[3], T::one());
 
             // Error estimate
-            let mut err_est = OVector::zeros_generic(rows, cols);
+            err_est.fill(T::zero());
             for (i, k_value) in k.iter().enumerate().take(12) {
-                err_est += k_value * dopri853::e::<T>(i + 1);
+                err_est.axpy(dopri853::e::<T>(i + 1), k_value, T::one());
             }
 
             // Compute error
             let mut err = T::zero();
             let mut err2 = T::zero();
-            let err_bhh = &k[3]
-                - &k[0] * dopri853::bhh::<T>(1)
-                - &k[8] * dopri853::bhh::<T>(2)
-                - &k[2] * dopri853::bhh::<T>(3);
+            err_bhh.copy_from(&k[3]);
+            err_bhh.axpy(-dopri853::bhh::<T>(1), &k[0], T::one());
+            err_bhh.axpy(-dopri853::bhh::<T>(2), &k[8], T::one());
+            err_bhh.axpy(-dopri853::bhh::<T>(3), &k[2], T::one());
             for i in 0..dim {
                 let y_i = self.y[i];
                 let k5_i = k[4][i];
