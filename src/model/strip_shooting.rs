@@ -22,7 +22,7 @@ use crate::model::ode::{
     IntegrationError, REFERENCE_TOLERANCE, hermite, integrate, integrate_stops,
 };
 use crate::model::rod::{Clamps, RodState};
-use crate::model::shooting::end_mismatch;
+use crate::model::shooting::{balance_derivative, end_mismatch};
 use nalgebra::{Matrix2, SVector, Vector2, Vector3, Vector6};
 use std::f64::consts::PI;
 
@@ -231,24 +231,18 @@ impl StripRhs {
 
     /// The right-hand side's derivative in y along `delta`.
     pub fn derivative(&self, delta: &StripOdeState) -> StripOdeState {
-        let (y, u, w) = (&self.state, &self.strains, &self.weight);
         let du = Vector3::new(delta[A], 0.0, delta[U3]);
-        let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
-        let (e1, e2, e3) = (part(delta, 1), part(delta, 2), part(delta, 3));
-        let (n, m) = (part(y, 4), part(y, 5));
-        let (dn, dm) = (part(delta, 4), part(delta, 5));
         let mut f = StripOdeState::zeros();
-        set(&mut f, 0, e3);
-        set(&mut f, 1, u[2] * e2 + du[2] * d2 - u[1] * e3 - du[1] * d3);
-        set(&mut f, 2, u[0] * e3 + du[0] * d3 - u[2] * e1 - du[2] * d1);
-        set(&mut f, 3, u[1] * e1 + du[1] * d1 - u[0] * e2 - du[0] * d2);
-        let load = Vector3::new(w.dot(&e1), w.dot(&e2), w.dot(&e3));
-        set(&mut f, 4, dn.cross(u) + n.cross(&du) - load);
-        set(
-            &mut f,
-            5,
-            dm.cross(u) + m.cross(&du) + Vector3::new(dn[1], -dn[0], 0.0),
+        let rates = balance_derivative(
+            self.state.as_slice(),
+            &self.strains,
+            delta.as_slice(),
+            &du,
+            &self.weight,
         );
+        for (k, v) in rates.into_iter().enumerate() {
+            set(&mut f, k, v);
+        }
         f[TWIST] = du[2];
         // H (a', u3')ᵀ = (m1', m3')ᵀ differentiated: H δ(a', u3') + δH (a', u3') = δ(m1', m3')
         let [w_aaa, w_aau, w_auu, w_uuu] = self.third;
