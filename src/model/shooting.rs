@@ -32,26 +32,42 @@ pub fn rhs_loaded(
     weight: &Vector3<f64>,
     natural: &Vector3<f64>,
 ) -> OdeState {
-    let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
-    let n = part(y, 4);
     let m = part(y, 5);
     let u = Vector3::new(m[0], m[1] / k2, m[2] / k3) + natural;
     let mut f = OdeState::zeros();
-    let set = |f: &mut OdeState, k: usize, v: Vector3<f64>| {
-        f[3 * k] = v[0];
-        f[3 * k + 1] = v[1];
-        f[3 * k + 2] = v[2];
-    };
-    set(&mut f, 0, d3);
-    set(&mut f, 1, u[2] * d2 - u[1] * d3);
-    set(&mut f, 2, u[0] * d3 - u[2] * d1);
-    set(&mut f, 3, u[1] * d1 - u[0] * d2);
-    // n' = n × u − f, m' = m × u + n × d3 (components in the material frame)
-    let load = Vector3::new(weight.dot(&d1), weight.dot(&d2), weight.dot(&d3));
-    set(&mut f, 4, n.cross(&u) - load);
-    set(&mut f, 5, m.cross(&u) + Vector3::new(n[1], -n[0], 0.0));
+    put_rates(&mut f, balance(y.as_slice(), &u, weight));
     f[18] = u[2];
     f
+}
+
+/// The rates r', d1', d2', d3', n', m' of (A.2) with strains u and a body
+/// force `weight` (lab frame), from a state holding r, d1, d2, d3, n, m
+/// first: the equations the rod and the strip share. n' = n × u − f and
+/// m' = m × u + n × d3 in material components, f_i = w g·d_i.
+pub fn balance(y: &[f64], u: &Vector3<f64>, weight: &Vector3<f64>) -> [Vector3<f64>; 6] {
+    let (d1, d2, d3) = (at(y, 1), at(y, 2), at(y, 3));
+    let (n, m) = (at(y, 4), at(y, 5));
+    let load = Vector3::new(weight.dot(&d1), weight.dot(&d2), weight.dot(&d3));
+    [
+        d3,
+        u[2] * d2 - u[1] * d3,
+        u[0] * d3 - u[2] * d1,
+        u[1] * d1 - u[0] * d2,
+        n.cross(u) - load,
+        m.cross(u) + Vector3::new(n[1], -n[0], 0.0),
+    ]
+}
+
+/// The six rates of [`balance`] (or its derivative) into the first 18
+/// entries of a state's rate.
+pub fn put_rates<const D: usize>(f: &mut SVector<f64, D>, rates: [Vector3<f64>; 6]) {
+    for (k, v) in rates.iter().enumerate() {
+        f.fixed_rows_mut::<3>(3 * k).copy_from(v);
+    }
+}
+
+fn at(v: &[f64], k: usize) -> Vector3<f64> {
+    Vector3::new(v[3 * k], v[3 * k + 1], v[3 * k + 2])
 }
 
 /// The derivative of [`rhs_loaded`] in the state at `y` along `delta`,
@@ -68,20 +84,17 @@ pub fn rhs_loaded_derivative(
     let u = Vector3::new(m[0], m[1] / k2, m[2] / k3) + natural;
     let du = Vector3::new(dm[0], dm[1] / k2, dm[2] / k3);
     let mut f = OdeState::zeros();
-    for (k, v) in balance_derivative(y.as_slice(), &u, delta.as_slice(), &du, weight)
-        .iter()
-        .enumerate()
-    {
-        f.fixed_rows_mut::<3>(3 * k).copy_from(v);
-    }
+    put_rates(
+        &mut f,
+        balance_derivative(y.as_slice(), &u, delta.as_slice(), &du, weight),
+    );
     f[18] = du[2];
     f
 }
 
-/// The rates r', d1', d2', d3', n', m' of (A.2) with strains u and a body
-/// force `weight` (lab frame), differentiated along a perturbation `delta`
-/// of the state (r, d1, d2, d3, n, m first, as `y`) and `du` of the strains:
-/// the variational equations the rod and the strip share.
+/// [`balance`] differentiated along a perturbation `delta` of the state
+/// (r, d1, d2, d3, n, m first, as `y`) and `du` of the strains: the
+/// variational equations the rod and the strip share.
 pub fn balance_derivative(
     y: &[f64],
     u: &Vector3<f64>,
@@ -89,7 +102,6 @@ pub fn balance_derivative(
     du: &Vector3<f64>,
     weight: &Vector3<f64>,
 ) -> [Vector3<f64>; 6] {
-    let at = |v: &[f64], k: usize| Vector3::new(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
     let (d1, d2, d3) = (at(y, 1), at(y, 2), at(y, 3));
     let (e1, e2, e3) = (at(delta, 1), at(delta, 2), at(delta, 3));
     let (n, m) = (at(y, 4), at(y, 5));

@@ -22,7 +22,7 @@ use crate::model::ode::{
     IntegrationError, REFERENCE_TOLERANCE, hermite, integrate, integrate_stops,
 };
 use crate::model::rod::{Clamps, RodState};
-use crate::model::shooting::{balance_derivative, end_mismatch};
+use crate::model::shooting::{balance, balance_derivative, end_mismatch, put_rates};
 use nalgebra::{Matrix2, SVector, Vector2, Vector3, Vector6};
 use std::f64::consts::PI;
 
@@ -155,37 +155,31 @@ pub fn strip_rhs(
     weight: &Vector3<f64>,
     natural: &NaturalStrains,
 ) -> StripOdeState {
+    rates(s, y, regularisation, weight, natural).0
+}
+
+/// y' at (s, y) with the strains u = (u1, 0, u3) and H⁻¹ of (4.3) it used:
+/// (A.2)'s frame, force and moment rates, ∫u3, and (a', u3') = H⁻¹ (m1',
+/// m3'), NaN where the law's Hessian is singular (the integration then
+/// stops as not finite).
+fn rates(
+    s: f64,
+    y: &StripOdeState,
+    regularisation: f64,
+    weight: &Vector3<f64>,
+    natural: &NaturalStrains,
+) -> (StripOdeState, Vector3<f64>, Matrix2<f64>) {
     let u = Vector3::new(y[A] + natural.at(s)[0], 0.0, y[U3]);
-    let mut f = balance(y, &u, weight);
+    let mut f = StripOdeState::zeros();
+    put_rates(&mut f, balance(y.as_slice(), &u, weight));
+    f[TWIST] = u[2];
     // (4.3): the law's moments follow m1' and m3' through its Hessian
     let (_, h) = sadowsky(y[A], y[U3], regularisation);
-    let du = inverse_law(&h) * Vector2::new(f[15], f[17]);
+    let inverse = h.try_inverse().unwrap_or(Matrix2::repeat(f64::NAN));
+    let du = inverse * Vector2::new(f[15], f[17]);
     f[A] = du[0];
     f[U3] = du[1];
-    f
-}
-
-/// The frame, force and moment equations of (A.2) with u = (u1, 0, u3),
-/// and ∫u3 ds: every rate but the strains'.
-fn balance(y: &StripOdeState, u: &Vector3<f64>, weight: &Vector3<f64>) -> StripOdeState {
-    let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
-    let (n, m) = (part(y, 4), part(y, 5));
-    let mut f = StripOdeState::zeros();
-    set(&mut f, 0, d3);
-    set(&mut f, 1, u[2] * d2 - u[1] * d3);
-    set(&mut f, 2, u[0] * d3 - u[2] * d1);
-    set(&mut f, 3, u[1] * d1 - u[0] * d2);
-    let load = Vector3::new(weight.dot(&d1), weight.dot(&d2), weight.dot(&d3));
-    set(&mut f, 4, n.cross(u) - load);
-    set(&mut f, 5, m.cross(u) + Vector3::new(n[1], -n[0], 0.0));
-    f[TWIST] = u[2];
-    f
-}
-
-/// H⁻¹ of (4.3), (a', u3') = H⁻¹ (m1', m3'); NaN where the law's Hessian
-/// is singular (the integration then stops as not finite).
-fn inverse_law(h: &Matrix2<f64>) -> Matrix2<f64> {
-    h.try_inverse().unwrap_or(Matrix2::repeat(f64::NAN))
+    (f, u, inverse)
 }
 
 /// The strip ODE's right-hand side at one (s, y) with what its derivative
@@ -212,13 +206,7 @@ impl StripRhs {
         weight: &Vector3<f64>,
         natural: &NaturalStrains,
     ) -> Self {
-        let strains = Vector3::new(y[A] + natural.at(s)[0], 0.0, y[U3]);
-        let mut value = balance(y, &strains, weight);
-        let (_, h) = sadowsky(y[A], y[U3], regularisation);
-        let inverse_hessian = inverse_law(&h);
-        let du = inverse_hessian * Vector2::new(value[15], value[17]);
-        value[A] = du[0];
-        value[U3] = du[1];
+        let (value, strains, inverse_hessian) = rates(s, y, regularisation, weight, natural);
         StripRhs {
             value,
             state: *y,
@@ -233,16 +221,16 @@ impl StripRhs {
     pub fn derivative(&self, delta: &StripOdeState) -> StripOdeState {
         let du = Vector3::new(delta[A], 0.0, delta[U3]);
         let mut f = StripOdeState::zeros();
-        let rates = balance_derivative(
-            self.state.as_slice(),
-            &self.strains,
-            delta.as_slice(),
-            &du,
-            &self.weight,
+        put_rates(
+            &mut f,
+            balance_derivative(
+                self.state.as_slice(),
+                &self.strains,
+                delta.as_slice(),
+                &du,
+                &self.weight,
+            ),
         );
-        for (k, v) in rates.into_iter().enumerate() {
-            set(&mut f, k, v);
-        }
         f[TWIST] = du[2];
         // H (a', u3')ᵀ = (m1', m3')ᵀ differentiated: H δ(a', u3') + δH (a', u3') = δ(m1', m3')
         let [w_aaa, w_aau, w_auu, w_uuu] = self.third;

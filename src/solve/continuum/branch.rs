@@ -156,7 +156,8 @@ pub struct Located {
     pub value: f64,
     /// Secant steps taken.
     pub steps: usize,
-    /// The last secant step in the held coordinate.
+    /// The last secant step in the held coordinate: along the parameter,
+    /// the step predicted from the last point and found too small to take.
     pub last_step: f64,
     /// The point before it.
     pub previous: BranchPoint,

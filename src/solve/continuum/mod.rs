@@ -166,6 +166,34 @@ pub struct Frame {
     pub d1_rate: Vector3<f64>,
 }
 
+/// The rate of a state (`core`, its rate `value`) and of its six
+/// perturbations (the blocks of `y` after it, each the state's size) by the
+/// equations' `derivative`; with `lambda` = ω² the perturbations obey the
+/// linearised dynamics (A.4): each n̄_i' gains −ω² r̄·d_i (unit mass per
+/// length, no rotary inertia).
+fn with_perturbations<const C: usize, const V: usize>(
+    y: &SVector<f64, V>,
+    core: &SVector<f64, C>,
+    value: SVector<f64, C>,
+    derivative: impl Fn(&SVector<f64, C>) -> SVector<f64, C>,
+    lambda: f64,
+) -> SVector<f64, V> {
+    let mut dy = SVector::<f64, V>::zeros();
+    dy.fixed_rows_mut::<C>(0).copy_from(&value);
+    for c in 1..7 {
+        let delta: SVector<f64, C> = y.fixed_rows::<C>(C * c).into();
+        let mut jd = derivative(&delta);
+        if lambda != 0.0 {
+            let r = part(&delta, 0);
+            for i in 0..3 {
+                jd[12 + i] -= lambda * r.dot(&part(core, 1 + i));
+            }
+        }
+        dy.fixed_rows_mut::<C>(C * c).copy_from(&jd);
+    }
+    dy
+}
+
 fn part<const D: usize>(y: &SVector<f64, D>, k: usize) -> Vector3<f64> {
     Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
 }
@@ -303,20 +331,7 @@ impl Continuum {
     ) -> SVector<f64, STRIP_VARIATIONAL> {
         let core: StripOdeState = y.fixed_rows::<21>(0).into();
         let rhs = StripRhs::at(s, &core, regularisation, &self.weight, &self.natural);
-        let mut dy = SVector::<f64, STRIP_VARIATIONAL>::zeros();
-        dy.fixed_rows_mut::<21>(0).copy_from(&rhs.value);
-        for c in 1..7 {
-            let delta: StripOdeState = y.fixed_rows::<21>(21 * c).into();
-            let mut jd = rhs.derivative(&delta);
-            if lambda != 0.0 {
-                let r = part(&delta, 0);
-                for i in 0..3 {
-                    jd[12 + i] -= lambda * r.dot(&part(&core, 1 + i));
-                }
-            }
-            dy.fixed_rows_mut::<21>(21 * c).copy_from(&jd);
-        }
-        dy
+        with_perturbations(y, &core, rhs.value, |delta| rhs.derivative(delta), lambda)
     }
 
     /// The strip's right-hand side with the energy density and the weight's
@@ -480,21 +495,10 @@ impl Continuum {
     ) -> SVector<f64, VARIATIONAL> {
         let natural = self.natural.vector_at(s);
         let core: OdeState = y.fixed_rows::<19>(0).into();
-        let mut dy = SVector::<f64, VARIATIONAL>::zeros();
-        dy.fixed_rows_mut::<19>(0)
-            .copy_from(&rhs_loaded(&core, k2, k3, &self.weight, &natural));
-        for c in 1..7 {
-            let delta: OdeState = y.fixed_rows::<19>(19 * c).into();
-            let mut jd = rhs_loaded_derivative(&core, &delta, k2, k3, &self.weight, &natural);
-            if lambda != 0.0 {
-                let r = part(&delta, 0);
-                for i in 0..3 {
-                    jd[12 + i] -= lambda * r.dot(&part(&core, 1 + i));
-                }
-            }
-            dy.fixed_rows_mut::<19>(19 * c).copy_from(&jd);
-        }
-        dy
+        let value = rhs_loaded(&core, k2, k3, &self.weight, &natural);
+        let derivative =
+            |delta: &OdeState| rhs_loaded_derivative(&core, delta, k2, k3, &self.weight, &natural);
+        with_perturbations(y, &core, value, derivative, lambda)
     }
 
     /// The solution from an integration whose state holds r, d1, d2, d3, n,
