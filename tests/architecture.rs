@@ -461,3 +461,21 @@ fn roots_are_narrowed_in_solve() {
     // the check sees a hand-written bisection where there is one
     assert!(!files_outside_with(&["solve"], &["0.5 * (lo + hi)"]).is_empty());
 }
+
+/// The unit-test harness compiles the crate without its CLI (src/lib.rs):
+/// a unit test there would never run.
+#[test]
+fn the_cli_layer_holds_no_unit_tests() {
+    let mut files = Vec::new();
+    source_files(&root().join("src/cli"), &mut files);
+    assert!(!files.is_empty(), "no src/cli");
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        assert!(
+            !text.contains("#[cfg(test)]") && !text.contains("#[test]"),
+            "{} holds unit tests, which the harness never compiles (src/lib.rs): \
+             test it from tests/",
+            f.display()
+        );
+    }
+}
