@@ -13,7 +13,10 @@ use std::f64::consts::PI;
 /// State of (A.2): r, d1, d2, d3, n (material), m (material), and ∫u3 ds.
 pub type OdeState = SVector<f64, 19>;
 
-fn part(y: &OdeState, k: usize) -> Vector3<f64> {
+/// The k-th 3-vector of a state laid out as r, d1, d2, d3, n, m, … (the
+/// rod's, the strip's, a perturbation's).
+pub fn part(y: &(impl AsRef<[f64]> + ?Sized), k: usize) -> Vector3<f64> {
+    let y = y.as_ref();
     Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
 }
 
@@ -45,8 +48,8 @@ pub fn rhs_loaded(
 /// first: the equations the rod and the strip share. n' = n × u − f and
 /// m' = m × u + n × d3 in material components, f_i = w g·d_i.
 pub fn balance(y: &[f64], u: &Vector3<f64>, weight: &Vector3<f64>) -> [Vector3<f64>; 6] {
-    let (d1, d2, d3) = (at(y, 1), at(y, 2), at(y, 3));
-    let (n, m) = (at(y, 4), at(y, 5));
+    let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
+    let (n, m) = (part(y, 4), part(y, 5));
     let load = Vector3::new(weight.dot(&d1), weight.dot(&d2), weight.dot(&d3));
     [
         d3,
@@ -64,10 +67,6 @@ pub fn put_rates<const D: usize>(f: &mut SVector<f64, D>, rates: [Vector3<f64>; 
     for (k, v) in rates.iter().enumerate() {
         f.fixed_rows_mut::<3>(3 * k).copy_from(v);
     }
-}
-
-fn at(v: &[f64], k: usize) -> Vector3<f64> {
-    Vector3::new(v[3 * k], v[3 * k + 1], v[3 * k + 2])
 }
 
 /// The derivative of [`rhs_loaded`] in the state at `y` along `delta`,
@@ -102,10 +101,10 @@ pub fn balance_derivative(
     du: &Vector3<f64>,
     weight: &Vector3<f64>,
 ) -> [Vector3<f64>; 6] {
-    let (d1, d2, d3) = (at(y, 1), at(y, 2), at(y, 3));
-    let (e1, e2, e3) = (at(delta, 1), at(delta, 2), at(delta, 3));
-    let (n, m) = (at(y, 4), at(y, 5));
-    let (dn, dm) = (at(delta, 4), at(delta, 5));
+    let (d1, d2, d3) = (part(y, 1), part(y, 2), part(y, 3));
+    let (e1, e2, e3) = (part(delta, 1), part(delta, 2), part(delta, 3));
+    let (n, m) = (part(y, 4), part(y, 5));
+    let (dn, dm) = (part(delta, 4), part(delta, 5));
     let load = Vector3::new(weight.dot(&e1), weight.dot(&e2), weight.dot(&e3));
     [
         e3,

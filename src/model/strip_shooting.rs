@@ -22,7 +22,7 @@ use crate::model::ode::{
     IntegrationError, REFERENCE_TOLERANCE, hermite, integrate, integrate_stops,
 };
 use crate::model::rod::{Clamps, RodState};
-use crate::model::shooting::{balance, balance_derivative, end_mismatch, put_rates};
+use crate::model::shooting::{balance, balance_derivative, end_mismatch, part, put_rates};
 use nalgebra::{Matrix2, SVector, Vector2, Vector3, Vector6};
 use std::f64::consts::PI;
 
@@ -37,10 +37,6 @@ const A: usize = 18;
 const U3: usize = 19;
 /// Index of ∫u3 ds.
 const TWIST: usize = 20;
-
-fn part(y: &StripOdeState, k: usize) -> Vector3<f64> {
-    Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
-}
 
 fn set(f: &mut StripOdeState, k: usize, v: Vector3<f64>) {
     f[3 * k] = v[0];

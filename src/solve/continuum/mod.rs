@@ -24,7 +24,7 @@ use crate::model::natural::NaturalStrains;
 use crate::model::ode::{Integrated, IntegrationError, integrate, integrate_stops};
 use crate::model::rod::{Clamps, EndKind, Law, RodModel};
 use crate::model::shooting::{
-    OdeState, end_conditions, rhs_loaded, rhs_loaded_derivative, start_frame,
+    OdeState, end_conditions, part, rhs_loaded, rhs_loaded_derivative, start_frame,
 };
 use crate::model::strip_shooting::{StripOdeState, StripRhs, sadowsky, strip_rhs};
 use crate::solve::continuum::newton::{NewtonShootingFailure, newton_shooting};
@@ -192,10 +192,6 @@ fn with_perturbations<const C: usize, const V: usize>(
         dy.fixed_rows_mut::<C>(C * c).copy_from(&jd);
     }
     dy
-}
-
-fn part<const D: usize>(y: &SVector<f64, D>, k: usize) -> Vector3<f64> {
-    Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
 }
 
 impl Continuum {

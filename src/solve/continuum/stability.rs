@@ -12,6 +12,7 @@
 
 use crate::model::ode::integrate_stops;
 use crate::model::rod::EndKind;
+use crate::model::shooting::part;
 use crate::solve::continuum::{
     Continuum, ContinuumError, ContinuumLaw, STRIP_VARIATIONAL, Unknowns, VARIATIONAL,
 };
@@ -33,10 +34,6 @@ pub struct ContinuumSpectrum {
     pub values: Vec<f64>,
     /// Each one's error: its change at a 100 times looser tolerance.
     pub errors: Vec<f64>,
-}
-
-fn part(y: &[f64], k: usize) -> Vector3<f64> {
-    Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
 }
 
 /// B = [r̄; α] of the six perturbations in `y` (the state, then each
