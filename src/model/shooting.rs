@@ -15,7 +15,7 @@ pub type OdeState = SVector<f64, 19>;
 
 /// The k-th 3-vector of a state laid out as r, d1, d2, d3, n, m, … (the
 /// rod's, the strip's, a perturbation's).
-pub fn part(y: &(impl AsRef<[f64]> + ?Sized), k: usize) -> Vector3<f64> {
+pub(crate) fn part(y: &(impl AsRef<[f64]> + ?Sized), k: usize) -> Vector3<f64> {
     let y = y.as_ref();
     Vector3::new(y[3 * k], y[3 * k + 1], y[3 * k + 2])
 }

@@ -38,12 +38,6 @@ const U3: usize = 19;
 /// Index of ∫u3 ds.
 const TWIST: usize = 20;
 
-fn set(f: &mut StripOdeState, k: usize, v: Vector3<f64>) {
-    f[3 * k] = v[0];
-    f[3 * k + 1] = v[1];
-    f[3 * k + 2] = v[2];
-}
-
 /// Why strip shooting failed.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum StripShootingError {
@@ -334,8 +328,9 @@ fn strip_start(p: &StripUnknowns, regularisation: f64, natural: &NaturalStrains)
     y[3] = 1.0;
     y[7] = 1.0;
     y[11] = 1.0;
-    set(&mut y, 4, p.n0);
-    set(&mut y, 5, Vector3::new(m13[0], p.m2, m13[1]));
+    y.fixed_rows_mut::<3>(12).copy_from(&p.n0);
+    y.fixed_rows_mut::<3>(15)
+        .copy_from(&Vector3::new(m13[0], p.m2, m13[1]));
     y[A] = a0;
     y[U3] = p.u3;
     y
