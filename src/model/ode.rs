@@ -93,16 +93,33 @@ pub fn integrate<const D: usize>(
             steps,
         });
     }
-    let dx = 1.0 / (samples - 1) as f64;
-    // (Dense is the crate's default output)
-    let mut solver = Dop853::new(Rhs(&f), 0.0, 1.0, dx, y0, tolerance, tolerance);
-    solver.integrate().map_err(failure)?;
-    let mut dense: Vec<SVector<f64, D>> = solver.y_out().to_vec();
+    let mut dense = integrate_dense(y0, &f, tolerance, samples)?;
     // the crate's dense output at s = 1 itself is an extrapolation (errors
     // of 1e-10 seen); the step's own y(1) is exact to the tolerance
     if let Some(last) = dense.last_mut() {
         *last = end;
     }
+    Ok(Integrated {
+        end,
+        samples: dense,
+        steps,
+    })
+}
+
+/// y at `samples` (≥ 2) evenly spaced s in [0, 1] of y' = f(s, y) from
+/// y(0) = `y0`, by one integration at `tolerance` and its dense output (of
+/// order 7; at s = 1 an extrapolation, see [`integrate`]).
+pub fn integrate_dense<const D: usize>(
+    y0: SVector<f64, D>,
+    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+    tolerance: f64,
+    samples: usize,
+) -> Result<Vec<SVector<f64, D>>, IntegrationError> {
+    let dx = 1.0 / (samples.max(2) - 1) as f64;
+    // (Dense is the crate's default output)
+    let mut solver = Dop853::new(Rhs(&f), 0.0, 1.0, dx, y0, tolerance, tolerance);
+    solver.integrate().map_err(failure)?;
+    let dense: Vec<SVector<f64, D>> = solver.y_out().to_vec();
     if dense.len() != samples {
         return Err(IntegrationError {
             s: 1.0,
@@ -118,11 +135,7 @@ pub fn integrate<const D: usize>(
             why: IntegrationFailure::NotFinite,
         });
     }
-    Ok(Integrated {
-        end,
-        samples: dense,
-        steps,
-    })
+    Ok(dense)
 }
 
 /// The crate's failure, with where it stopped.
@@ -154,8 +167,17 @@ pub fn integrate_stops<const D: usize>(
     tolerance: f64,
     stops: &[f64],
 ) -> Result<(Vec<SVector<f64, D>>, u32), IntegrationError> {
-    let mut y = y0;
-    let mut from = 0.0;
+    integrate_stops_from(0.0, y0, &f, tolerance, stops)
+}
+
+/// [`integrate_stops`] from y(`from`) = `y`.
+fn integrate_stops_from<const D: usize>(
+    mut from: f64,
+    mut y: SVector<f64, D>,
+    f: &impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+    tolerance: f64,
+    stops: &[f64],
+) -> Result<(Vec<SVector<f64, D>>, u32), IntegrationError> {
     let mut out = Vec::with_capacity(stops.len());
     let mut steps = 0;
     for &to in stops {
@@ -168,7 +190,7 @@ pub fn integrate_stops<const D: usize>(
         if to > from {
             // the crate's defaults but the step budget
             let mut solver = Dop853::from_param(
-                Rhs(&f),
+                Rhs(f),
                 from,
                 to,
                 to - from,
@@ -202,6 +224,80 @@ pub fn integrate_stops<const D: usize>(
         from = to;
     }
     Ok((out, steps))
+}
+
+/// One integration of y' = f(s, y) from s = 0 to 1 kept as the state at
+/// each of its accepted steps' ends: y anywhere is then a short integration
+/// from the step end before it, as exact as a step's own end (no
+/// interpolation) at the cost of about one step instead of an integration
+/// from s = 0.
+#[derive(Clone, Debug)]
+pub struct Steps<const D: usize> {
+    /// s at the step ends, from 0 up.
+    s: Vec<f64>,
+    /// y there.
+    y: Vec<SVector<f64, D>>,
+}
+
+/// [`Steps`] of y' = f(s, y) from y(0) = `y0` to s = 1 at `tolerance`.
+pub fn integrate_steps<const D: usize>(
+    y0: SVector<f64, D>,
+    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+    tolerance: f64,
+) -> Result<Steps<D>, IntegrationError> {
+    let mut solver = Dop853::from_param(
+        Rhs(&f),
+        0.0,
+        1.0,
+        1.0,
+        y0,
+        tolerance,
+        tolerance,
+        0.9,
+        0.0,
+        0.333,
+        6.0,
+        1.0,
+        0.0,
+        MAX_STEPS,
+        1000,
+        OutputType::Sparse,
+    );
+    solver.integrate().map_err(failure)?;
+    let (s, y) = (solver.x_out().clone(), solver.y_out().clone());
+    if let Some(k) = y.iter().position(|v| v.iter().any(|c| !c.is_finite())) {
+        return Err(IntegrationError {
+            s: s[k],
+            why: IntegrationFailure::NotFinite,
+        });
+    }
+    Ok(Steps { s, y })
+}
+
+impl<const D: usize> Steps<D> {
+    /// y at each of the increasing `stops` in [0, 1] (`f` and `tolerance`
+    /// as integrated): from the step end at or before the first stop, then
+    /// from stop to stop as [`integrate_stops`], so that stops close
+    /// together (a central difference) come from one piece of integration.
+    pub fn at(
+        &self,
+        stops: &[f64],
+        f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+        tolerance: f64,
+    ) -> Result<Vec<SVector<f64, D>>, IntegrationError> {
+        let Some(&first) = stops.first() else {
+            return Ok(vec![]);
+        };
+        if !(0.0..=1.0).contains(&first) {
+            return Err(IntegrationError {
+                s: 0.0,
+                why: IntegrationFailure::BadStop(first),
+            });
+        }
+        // the last step end at or before the first stop (s[0] = 0)
+        let k = self.s.partition_point(|&s| s <= first).max(1) - 1;
+        Ok(integrate_stops_from(self.s[k], self.y[k], &f, tolerance, stops)?.0)
+    }
 }
 
 /// y(s) between the uniform `samples` of [0, 1] by cubic Hermite
@@ -260,6 +356,49 @@ mod tests {
         assert!((e.s - 0.5).abs() < 1e-3, "{e}");
         let e = integrate_stops(SVector::<f64, 1>::new(0.0), f, 1e-10, &[0.5, 0.2]).unwrap_err();
         assert_eq!(e.why, IntegrationFailure::BadStop(0.2));
+    }
+
+    /// A state anywhere from one integration's step ends is as exact as an
+    /// integration to it (y = (sin s, cos s) to 1e-12), costs a step or two,
+    /// and does not depend on the stops asked after it.
+    #[test]
+    fn states_between_step_ends_are_integrated_from_the_step_before() {
+        let f = |_: f64, y: &SVector<f64, 2>| SVector::<f64, 2>::new(y[1], -y[0]);
+        let steps = integrate_steps(SVector::<f64, 2>::new(0.0, 1.0), f, 1e-12).unwrap();
+        assert!(steps.s.len() > 3, "{} step ends", steps.s.len() - 1);
+        let stops = [0.0, 0.3, 0.3 + 1e-5, 0.7, 1.0];
+        let ys = steps.at(&stops, f, 1e-12).unwrap();
+        for (y, &s) in ys.iter().zip(&stops) {
+            assert!(
+                (y[0] - s.sin()).abs() < 1e-12,
+                "s = {s}: {}",
+                y[0] - s.sin()
+            );
+            assert!(
+                (y[1] - s.cos()).abs() < 1e-12,
+                "s = {s}: {}",
+                y[1] - s.cos()
+            );
+        }
+        // the first stop's state is integrated from its own step end
+        assert_eq!(
+            steps.at(&[0.7], f, 1e-12).unwrap()[0],
+            steps.at(&[0.7, 0.9], f, 1e-12).unwrap()[0]
+        );
+        // a stop between step ends: one short integration from the one before
+        let k = steps.s.len() / 2;
+        let middle = 0.5 * (steps.s[k] + steps.s[k + 1]);
+        let (_, taken) =
+            integrate_stops_from(steps.s[k], steps.y[k], &f, 1e-12, &[middle]).unwrap();
+        assert!(taken <= 2, "{taken} steps");
+        assert_eq!(
+            steps.at(&[0.5, 0.4], f, 1e-12).unwrap_err().why,
+            IntegrationFailure::BadStop(0.4)
+        );
+        assert_eq!(
+            steps.at(&[-0.1], f, 1e-12).unwrap_err().why,
+            IntegrationFailure::BadStop(-0.1)
+        );
     }
 
     #[test]

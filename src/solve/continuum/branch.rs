@@ -17,7 +17,7 @@
 //! other ([`TestFunction::RibbonCrossing`]).
 
 use crate::model::rod::{Clamps, Parameter, RodModel};
-use crate::solve::continuum::{Continuum, ContinuumError, Frame, Unknowns};
+use crate::solve::continuum::{Continuum, ContinuumError, Frame, Trajectory, Unknowns};
 use crate::solve::event::Vanishing;
 use crate::solve::root::{Iterate, NoRoot, Reach, Secant, SecantFailure, Start};
 use nalgebra::{Matrix6, SMatrix, SVector, Vector3, Vector6};
@@ -431,6 +431,13 @@ impl<'a> ContinuumBranch<'a> {
         Ok(self.problem(z[PARAMETER])?.frames_at(&p, stops)?)
     }
 
+    /// The solution at z as its integrator's steps, for frames at many
+    /// arclengths of one solution (a closest approach's Newton).
+    pub fn trajectory(&self, z: &BranchPoint) -> Result<Trajectory, BranchError> {
+        let p: Unknowns = z.fixed_rows::<6>(0).into();
+        Ok(self.problem(z[PARAMETER])?.into_trajectory(&p)?)
+    }
+
     /// The height of r along the s = 0 clamp's tangent (the walls' normal).
     fn height(&self, z: &BranchPoint, r: &Vector3<f64>) -> f64 {
         let c = self.clamps_at(z[PARAMETER]);
@@ -451,7 +458,7 @@ impl<'a> ContinuumBranch<'a> {
                 Ok((test.clone(), bordered_determinant(&j, left, right)?))
             }
             TestFunction::Wall { top, s } => {
-                let (s, h) = self.extremum(z, *s, *top)?;
+                let (s, h) = self.extremum(z, &self.trajectory(z)?, *s, *top)?;
                 // the top wall moves with z* along a branch in z*
                 let wall = if *top {
                     self.clamps_at(z[PARAMETER]).top_wall()
@@ -462,15 +469,15 @@ impl<'a> ContinuumBranch<'a> {
             }
             TestFunction::Walls => Ok((TestFunction::Walls, self.wall_gap(z)?)),
             TestFunction::Crossing { s } => {
-                let (s, d, _) = self.closest_strands(z, *s)?;
+                let (s, d, _) = self.closest_strands(&self.trajectory(z)?, *s)?;
                 Ok((TestFunction::Crossing { s }, d))
             }
             TestFunction::RibbonCrossing { s } => {
-                let (s, gap) = self.ribbon_gap(z, *s)?;
+                let (s, gap) = self.ribbon_gap(&self.trajectory(z)?, *s)?;
                 Ok((TestFunction::RibbonCrossing { s }, gap))
             }
             TestFunction::Merging { s } => {
-                let (s, _, det) = self.closest_strands(z, *s)?;
+                let (s, _, det) = self.closest_strands(&self.trajectory(z)?, *s)?;
                 Ok((TestFunction::Merging { s }, det))
             }
         }
@@ -489,7 +496,9 @@ impl<'a> ContinuumBranch<'a> {
     pub fn height_range(&self, z: &BranchPoint) -> Result<HeightRange, BranchError> {
         const SAMPLES: usize = 200;
         let stops: Vec<f64> = (1..SAMPLES).map(|k| k as f64 / SAMPLES as f64).collect();
-        let frames = self.frames_at(z, &stops)?;
+        let p: Unknowns = z.fixed_rows::<6>(0).into();
+        let sampled = self.problem(z[PARAMETER])?.frames_sampled(&p, SAMPLES)?;
+        let frames = &sampled[1..SAMPLES];
         let axis = self.clamps_at(z[PARAMETER]).start_tangent();
         let (low, high) = frames
             .iter()
@@ -522,21 +531,27 @@ impl<'a> ContinuumBranch<'a> {
         }
         let (_, i, upper) =
             best.ok_or_else(|| BranchError::NoRoot("no interior extremum of the height".into()))?;
-        let (_, height) = self.extremum(z, stops[i], upper)?;
+        let (_, height) = self.extremum(z, &self.trajectory(z)?, stops[i], upper)?;
         Ok(if upper { top - height } else { height })
     }
 
     /// The interior extremum of the height nearest arclength `s0`: Newton
     /// on h'(s) = d3·e = 0 with h''(s) = d3'·e from the frame equations. On
     /// a ribbon, the extremum of its highest (`upper`) or lowest edge.
-    fn extremum(&self, z: &BranchPoint, s0: f64, upper: bool) -> Result<(f64, f64), BranchError> {
+    fn extremum(
+        &self,
+        z: &BranchPoint,
+        path: &Trajectory,
+        s0: f64,
+        upper: bool,
+    ) -> Result<(f64, f64), BranchError> {
         if self.ribbon > 0.0 {
-            return self.edge_extremum(z, s0, upper);
+            return self.edge_extremum(z, path, s0, upper);
         }
         let axis = self.clamps_at(z[PARAMETER]).start_tangent();
         let mut s = s0;
         for _ in 0..30 {
-            let (f, d) = self.frame_and_rate(z, s)?;
+            let (f, d) = frame_and_rate(path, s)?;
             let slope = f.d3.dot(&axis);
             let curvature = d.dot(&axis);
             if curvature == 0.0 || !curvature.is_finite() {
@@ -545,7 +560,7 @@ impl<'a> ContinuumBranch<'a> {
             let step = -slope / curvature;
             s = (s + step).clamp(1e-6, 1.0 - 1e-6);
             if step.abs() < 1e-13 {
-                let f = self.frames_at(z, &[s])?[0];
+                let f = path.frames_at(&[s])?[0];
                 return Ok((s, self.height(z, &f.r)));
             }
         }
@@ -562,6 +577,7 @@ impl<'a> ContinuumBranch<'a> {
     fn edge_extremum(
         &self,
         z: &BranchPoint,
+        path: &Trajectory,
         s0: f64,
         upper: bool,
     ) -> Result<(f64, f64), BranchError> {
@@ -578,7 +594,7 @@ impl<'a> ContinuumBranch<'a> {
         for _ in 0..30 {
             let lo = (s - DS).max(1e-6);
             let hi = (s + DS).min(1.0 - 1e-6);
-            let f = self.frames_at(z, &[lo, s, hi])?;
+            let f = path.frames_at(&[lo, s, hi])?;
             let curvature = (slope(&f[2]) - slope(&f[0])) / (hi - lo);
             if curvature == 0.0 || !curvature.is_finite() {
                 break;
@@ -586,7 +602,7 @@ impl<'a> ContinuumBranch<'a> {
             let step = -slope(&f[1]) / curvature;
             s = (s + step).clamp(1e-6, 1.0 - 1e-6);
             if step.abs() < 1e-12 {
-                let f = self.frames_at(z, &[s])?[0];
+                let f = path.frames_at(&[s])?[0];
                 return Ok((s, value(&f)));
             }
         }
@@ -604,12 +620,12 @@ impl<'a> ContinuumBranch<'a> {
     /// no closest approach within [`EDGE_REACH`] of the centrelines' (the
     /// edges turn away from each other there) cannot touch there and is
     /// left out.
-    fn ribbon_gap(&self, z: &BranchPoint, s0: [f64; 2]) -> Result<([f64; 2], f64), BranchError> {
-        let (s, centre, _) = self.closest_strands(z, s0)?;
+    fn ribbon_gap(&self, path: &Trajectory, s0: [f64; 2]) -> Result<([f64; 2], f64), BranchError> {
+        let (s, centre, _) = self.closest_strands(path, s0)?;
         let side = centre.signum();
         let mut gap = f64::INFINITY;
         for signs in [[1.0, 1.0], [1.0, -1.0], [-1.0, 1.0], [-1.0, -1.0]] {
-            if let Some(signed) = self.edge_distance(z, s, signs)? {
+            if let Some(signed) = self.edge_distance(path, s, signs)? {
                 gap = gap.min(side * signed);
             }
         }
@@ -628,7 +644,7 @@ impl<'a> ContinuumBranch<'a> {
     /// approach (a minimum of their distance) within [`EDGE_REACH`].
     fn edge_distance(
         &self,
-        z: &BranchPoint,
+        path: &Trajectory,
         s0: [f64; 2],
         signs: [f64; 2],
     ) -> Result<Option<f64>, BranchError> {
@@ -638,7 +654,7 @@ impl<'a> ContinuumBranch<'a> {
         // position, tangent and rate of change of the tangent of one edge
         let edge = |s: f64, sign: f64| -> Result<_, BranchError> {
             let (lo, hi) = ((s - DS).max(0.0), (s + DS).min(1.0));
-            let f = self.frames_at(z, &[lo, s, hi])?;
+            let f = path.frames_at(&[lo, s, hi])?;
             let rate = (tangent(&f[2], sign) - tangent(&f[0], sign)) / (hi - lo);
             Ok((f[1].r + sign * half * f[1].d1, tangent(&f[1], sign), rate))
         };
@@ -705,30 +721,20 @@ impl<'a> ContinuumBranch<'a> {
         Ok(None)
     }
 
-    /// The frame at s and d3'(s).
-    fn frame_and_rate(
-        &self,
-        z: &BranchPoint,
-        s: f64,
-    ) -> Result<(Frame, Vector3<f64>), BranchError> {
-        let f = self.frames_at(z, &[s])?[0];
-        Ok((f, f.curvature))
-    }
-
     /// The closest points of two strands near arclengths `s0` (Newton on
     /// the two orthogonality conditions), their signed distance, positive
     /// along t_a × t_b, and the determinant of the conditions' Jacobian.
     fn closest_strands(
         &self,
-        z: &BranchPoint,
+        path: &Trajectory,
         s0: [f64; 2],
     ) -> Result<([f64; 2], f64, f64), BranchError> {
         let mut s = s0;
         // next to a merger of critical points Newton converges only
         // linearly (by 2/3 a step at a pitchfork)
         for _ in 0..100 {
-            let (fa, ra) = self.frame_and_rate(z, s[0])?;
-            let (fb, rb) = self.frame_and_rate(z, s[1])?;
+            let (fa, ra) = frame_and_rate(path, s[0])?;
+            let (fb, rb) = frame_and_rate(path, s[1])?;
             let d = fa.r - fb.r;
             let g = nalgebra::Vector2::new(d.dot(&fa.d3), -d.dot(&fb.d3));
             let jac = nalgebra::Matrix2::new(
@@ -746,7 +752,8 @@ impl<'a> ContinuumBranch<'a> {
                 (s[1] + step[1]).clamp(0.0, 1.0),
             ];
             if step.norm() < 1e-13 {
-                let f = self.frames_at(z, &[s[0], s[1]])?;
+                // each from its own step end, as in the iterations
+                let f = [path.frames_at(&[s[0]])?[0], path.frames_at(&[s[1]])?[0]];
                 let normal = f[0].d3.cross(&f[1].d3);
                 if normal.norm() < 1e-8 {
                     break;
@@ -891,4 +898,10 @@ fn bordered_determinant(
         .solve(&rhs)
         .map(|x| x[6])
         .ok_or(BranchError::Continuum(ContinuumError::Singular))
+}
+
+/// The frame at s and d3'(s).
+fn frame_and_rate(path: &Trajectory, s: f64) -> Result<(Frame, Vector3<f64>), BranchError> {
+    let f = path.frames_at(&[s])?[0];
+    Ok((f, f.curvature))
 }

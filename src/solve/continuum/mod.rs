@@ -21,7 +21,10 @@ pub mod stability;
 
 use crate::model::energy::strip_energy;
 use crate::model::natural::NaturalStrains;
-use crate::model::ode::{Integrated, IntegrationError, integrate, integrate_stops};
+use crate::model::ode::{
+    Integrated, IntegrationError, Steps, integrate, integrate_dense, integrate_steps,
+    integrate_stops,
+};
 use crate::model::rod::{Clamps, EndKind, Law, RodModel};
 use crate::model::shooting::{
     OdeState, end_conditions, part, rhs_loaded, rhs_loaded_derivative, start_frame,
@@ -164,6 +167,80 @@ pub struct Frame {
     pub curvature: Vector3<f64>,
     /// d1'(s): how the ribbon's edges r ± (w/2) d1 turn.
     pub d1_rate: Vector3<f64>,
+}
+
+/// The frame of a state `y` (r, d1, d2, d3 first) with its rate `dy`.
+fn frame(y: &[f64], dy: &[f64]) -> Frame {
+    Frame {
+        r: Vector3::from_column_slice(&y[0..3]),
+        d1: Vector3::from_column_slice(&y[3..6]),
+        d2: Vector3::from_column_slice(&y[6..9]),
+        d3: Vector3::from_column_slice(&y[9..12]),
+        curvature: Vector3::from_column_slice(&dy[9..12]),
+        d1_rate: Vector3::from_column_slice(&dy[3..6]),
+    }
+}
+
+/// The frames of uniform samples y_k (s = k / (len − 1)) of y' = f(s, y).
+fn sampled_frames<const D: usize>(
+    ys: &[SVector<f64, D>],
+    f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+) -> Vec<Frame> {
+    let ds = 1.0 / (ys.len().max(2) - 1) as f64;
+    ys.iter()
+        .enumerate()
+        .map(|(k, y)| frame(y.as_slice(), f(k as f64 * ds, y).as_slice()))
+        .collect()
+}
+
+/// A continuum solution kept as its integrator's steps
+/// ([`Continuum::into_trajectory`]).
+pub struct Trajectory {
+    continuum: Continuum,
+    path: Path,
+}
+
+/// The steps of a rod's or a strip's integration, with its law.
+enum Path {
+    Rod {
+        steps: Steps<ROD>,
+        k2: f64,
+        k3: f64,
+    },
+    Strip {
+        steps: Steps<STRIP>,
+        regularisation: f64,
+    },
+}
+
+impl Trajectory {
+    /// The frames at the increasing arclengths `stops`: from the step end
+    /// at or before the first, then from stop to stop, so that stops close
+    /// together (a central difference) come from one piece of integration.
+    pub fn frames_at(&self, stops: &[f64]) -> Result<Vec<Frame>, ContinuumError> {
+        let c = &self.continuum;
+        Ok(match &self.path {
+            Path::Rod { steps, k2, k3 } => {
+                let f = |s: f64, y: &SVector<f64, ROD>| c.rod_rhs(s, y, *k2, *k3);
+                let ys = steps.at(stops, f, c.tolerance)?;
+                ys.iter()
+                    .zip(stops)
+                    .map(|(y, &s)| frame(y.as_slice(), f(s, y).as_slice()))
+                    .collect()
+            }
+            Path::Strip {
+                steps,
+                regularisation,
+            } => {
+                let f = |s: f64, y: &SVector<f64, STRIP>| c.strip_rhs(s, y, *regularisation);
+                let ys = steps.at(stops, f, c.tolerance)?;
+                ys.iter()
+                    .zip(stops)
+                    .map(|(y, &s)| frame(y.as_slice(), f(s, y).as_slice()))
+                    .collect()
+            }
+        })
+    }
 }
 
 /// The rate of a state (`core`, its rate `value`) and of its six
@@ -374,14 +451,6 @@ impl Continuum {
     /// in [0, 1], from `p`.
     pub fn frames_at(&self, p: &Unknowns, stops: &[f64]) -> Result<Vec<Frame>, ContinuumError> {
         check_finite(p)?;
-        let frame = |y: &[f64], dy: &[f64]| Frame {
-            r: Vector3::from_column_slice(&y[0..3]),
-            d1: Vector3::from_column_slice(&y[3..6]),
-            d2: Vector3::from_column_slice(&y[6..9]),
-            d3: Vector3::from_column_slice(&y[9..12]),
-            curvature: Vector3::from_column_slice(&dy[9..12]),
-            d1_rate: Vector3::from_column_slice(&dy[3..6]),
-        };
         Ok(match self.law {
             ContinuumLaw::Kirchhoff { k2, k3 } => {
                 let f = |s: f64, y: &SVector<f64, ROD>| self.rod_rhs(s, y, k2, k3);
@@ -399,6 +468,60 @@ impl Continuum {
                     .zip(stops)
                     .map(|(y, &s)| frame(y.as_slice(), f(s, y).as_slice()))
                     .collect()
+            }
+        })
+    }
+
+    /// The solution from `p` as its integrator's steps: frames anywhere on
+    /// it at the cost of about one step each ([`Trajectory::frames_at`]).
+    pub fn into_trajectory(self, p: &Unknowns) -> Result<Trajectory, ContinuumError> {
+        check_finite(p)?;
+        let path = match self.law {
+            ContinuumLaw::Kirchhoff { k2, k3 } => {
+                let f = |s: f64, y: &SVector<f64, ROD>| self.rod_rhs(s, y, k2, k3);
+                Path::Rod {
+                    steps: integrate_steps(self.rod_start(p), f, self.tolerance)?,
+                    k2,
+                    k3,
+                }
+            }
+            ContinuumLaw::Strip { regularisation } => {
+                let f = |s: f64, y: &SVector<f64, STRIP>| self.strip_rhs(s, y, regularisation);
+                let y0 = self.strip_start(p, regularisation).0;
+                Path::Strip {
+                    steps: integrate_steps(y0, f, self.tolerance)?,
+                    regularisation,
+                }
+            }
+        };
+        Ok(Trajectory {
+            continuum: self,
+            path,
+        })
+    }
+
+    /// The frames at s = k / `intervals`, k = 0..=intervals, from `p`, by
+    /// one integration and its dense output (of order 7, to about the
+    /// integrator's tolerance): for scanning the solution, not for a value
+    /// a root is located on.
+    pub fn frames_sampled(
+        &self,
+        p: &Unknowns,
+        intervals: usize,
+    ) -> Result<Vec<Frame>, ContinuumError> {
+        check_finite(p)?;
+        let samples = intervals.max(1) + 1;
+        Ok(match self.law {
+            ContinuumLaw::Kirchhoff { k2, k3 } => {
+                let f = |s: f64, y: &SVector<f64, ROD>| self.rod_rhs(s, y, k2, k3);
+                let ys = integrate_dense(self.rod_start(p), f, self.tolerance, samples)?;
+                sampled_frames(&ys, f)
+            }
+            ContinuumLaw::Strip { regularisation } => {
+                let f = |s: f64, y: &SVector<f64, STRIP>| self.strip_rhs(s, y, regularisation);
+                let y0 = self.strip_start(p, regularisation).0;
+                let ys = integrate_dense(y0, f, self.tolerance, samples)?;
+                sampled_frames(&ys, f)
             }
         })
     }
