@@ -170,6 +170,38 @@ pub fn integrate_stops<const D: usize>(
     integrate_stops_from(0.0, y0, &f, tolerance, stops)
 }
 
+/// DOP853 from y(`from`) = `y` to `to` with the crate's defaults but the step
+/// budget, its output each accepted step's end.
+fn sparse_solver<const D: usize, F>(
+    f: &F,
+    from: f64,
+    to: f64,
+    y: SVector<f64, D>,
+    tolerance: f64,
+) -> Dop853<f64, SVector<f64, D>, Rhs<&F>>
+where
+    F: Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
+{
+    Dop853::from_param(
+        Rhs(f),
+        from,
+        to,
+        to - from,
+        y,
+        tolerance,
+        tolerance,
+        0.9,
+        0.0,
+        0.333,
+        6.0,
+        to - from,
+        0.0,
+        MAX_STEPS,
+        1000,
+        OutputType::Sparse,
+    )
+}
+
 /// [`integrate_stops`] from y(`from`) = `y`.
 fn integrate_stops_from<const D: usize>(
     mut from: f64,
@@ -188,25 +220,7 @@ fn integrate_stops_from<const D: usize>(
             });
         }
         if to > from {
-            // the crate's defaults but the step budget
-            let mut solver = Dop853::from_param(
-                Rhs(f),
-                from,
-                to,
-                to - from,
-                y,
-                tolerance,
-                tolerance,
-                0.9,
-                0.0,
-                0.333,
-                6.0,
-                to - from,
-                0.0,
-                MAX_STEPS,
-                1000,
-                OutputType::Sparse,
-            );
+            let mut solver = sparse_solver(f, from, to, y, tolerance);
             steps += solver.integrate().map_err(failure)?.accepted_steps;
             // the crate's sparse output holds at least the end
             y = *solver.y_out().last().ok_or(IntegrationError {
@@ -245,24 +259,7 @@ pub fn integrate_steps<const D: usize>(
     f: impl Fn(f64, &SVector<f64, D>) -> SVector<f64, D>,
     tolerance: f64,
 ) -> Result<Steps<D>, IntegrationError> {
-    let mut solver = Dop853::from_param(
-        Rhs(&f),
-        0.0,
-        1.0,
-        1.0,
-        y0,
-        tolerance,
-        tolerance,
-        0.9,
-        0.0,
-        0.333,
-        6.0,
-        1.0,
-        0.0,
-        MAX_STEPS,
-        1000,
-        OutputType::Sparse,
-    );
+    let mut solver = sparse_solver(&f, 0.0, 1.0, y0, tolerance);
     solver.integrate().map_err(failure)?;
     let (s, y) = (solver.x_out().clone(), solver.y_out().clone());
     if let Some(k) = y.iter().position(|v| v.iter().any(|c| !c.is_finite())) {
