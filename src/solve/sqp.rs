@@ -276,6 +276,8 @@ struct Sqp<'a> {
     z: Vec<f64>,
     /// Contact forces of the last QP, by (segments, obstacle kind).
     forces: Vec<(Gap, f64)>,
+    /// This QP was solved exactly by the active-set iteration alone.
+    exact_qp: bool,
     /// Largest translation of the uncapped step.
     largest: f64,
     /// Exact penalty weight of the contact gaps in the merit.
@@ -348,6 +350,7 @@ impl<'a> Sqp<'a> {
             lambda: Vec::new(),
             z: Vec::new(),
             forces: Vec::new(),
+            exact_qp: false,
             largest: 0.0,
             mu: 0.0,
             trial_step: vec![0.0; n],
@@ -473,12 +476,7 @@ impl<'a> Sqp<'a> {
                     hessian.wide = Some(ContactHessian::new(self.energy, &refs));
                 }
                 let forces = &self.forces;
-                let z = |g: &Gap| {
-                    forces
-                        .iter()
-                        .find(|f| same_pair(&f.0, g))
-                        .map_or(0.0, |f| f.1)
-                };
+                let z = |g: &Gap| last_force(forces, g);
                 let w = hessian.wide.as_mut().expect("built above");
                 w.fill(
                     self.energy,
@@ -531,8 +529,10 @@ impl<'a> Sqp<'a> {
         }
     }
 
-    /// The step: the QP's (clarabel) with its multipliers and contact forces,
-    /// or with nothing to constrain the (shifted) Newton step.
+    /// The step: the QP's with its multipliers and contact forces (contact
+    /// rows alone by the exact active-set iteration where it settles, else
+    /// clarabel's interior point), or with nothing to constrain the
+    /// (shifted) Newton step.
     fn solve_subproblem(&mut self, it: usize) -> Result<(), SolveError> {
         // QP: linear term ∇E + ρ Jᵀc = ∇(augmented) − Jᵀλ
         self.q.copy_from_slice(&self.grad);
@@ -548,6 +548,27 @@ impl<'a> Sqp<'a> {
             self.lambda = Vec::new();
             self.z = Vec::new();
             return Ok(());
+        }
+        self.exact_qp = false;
+        if self.m_eq == 0 {
+            // contact rows only: the exact active-set solution from the last
+            // QP's forces on the same pairs (none at first), which settles in
+            // a step or two once the contacts do; the interior point only
+            // where it does not
+            let guess: Vec<f64> = self
+                .gaps
+                .iter()
+                .map(|g| last_force(&self.forces, g))
+                .collect();
+            if let Some((d, z)) =
+                polish_contacts(ldlt, &self.q, &self.gap_rows, &self.gaps, &guess, None)
+            {
+                self.step = d;
+                self.lambda = Vec::new();
+                self.z = z;
+                self.exact_qp = true;
+                return Ok(());
+            }
         }
         let (a, b) = stack_rows(
             &self.jacobian.matrix,
@@ -615,7 +636,7 @@ impl<'a> Sqp<'a> {
     /// Polish (contacts, no equality rows): the exact QP solution by an
     /// active-set iteration from the interior point's duals.
     fn polish_contact_step(&mut self) {
-        if self.m_eq != 0 || self.gaps.is_empty() {
+        if self.m_eq != 0 || self.gaps.is_empty() || self.exact_qp {
             return;
         }
         let (pat, vals, ldlt) = self.hessian.parts();
@@ -813,8 +834,8 @@ impl<'a> Sqp<'a> {
 }
 
 /// The QP with contact rows only, solved exactly by a primal-dual active-set
-/// iteration started from the interior-point duals `z` (P factored in
-/// `ldlt`): each trial active set is solved as equalities through the
+/// iteration started from the forces `z` (the last QP's, or the interior
+/// point's duals; P factored in `ldlt`): each trial active set is solved as equalities through the
 /// small Schur complement G P⁻¹ Gᵀ (one sparse solve per row), a row with a
 /// negative force leaves it, the most violated other row joins it. Returns
 /// the step and the contact forces, or None if it does not settle.
@@ -937,6 +958,14 @@ fn merge_contacts(mut rows: Vec<ContactForce>, reach: f64) -> Vec<ContactForce> 
     let mut merged: Vec<ContactForce> = out.into_iter().map(|(c, _)| c).collect();
     merged.sort_by(|a, b| a.s.total_cmp(&b.s));
     merged
+}
+
+/// The force of the last QP on the pair of `g` (0 if it had none).
+fn last_force(forces: &[(Gap, f64)], g: &Gap) -> f64 {
+    forces
+        .iter()
+        .find(|f| same_pair(&f.0, g))
+        .map_or(0.0, |f| f.1)
 }
 
 /// The same contact pair (segments and kind of obstacle).
