@@ -541,6 +541,17 @@ impl<'a> Sqp<'a> {
                 .transpose_mul(&self.state.multipliers[1..], &mut self.jtl);
             self.q.iter_mut().zip(&self.jtl).for_each(|(g, j)| *g -= j);
         }
+        self.exact_qp = false;
+        if self.m_eq > 0 && self.gaps.is_empty() {
+            // equality rows only: the QP is its KKT system, solved exactly
+            self.step = vec![0.0; self.n];
+            self.lambda = vec![0.0; self.m_eq];
+            self.z = Vec::new();
+            if self.kkt_newton() {
+                self.exact_qp = true;
+                return Ok(());
+            }
+        }
         let (pat, vals, ldlt) = self.hessian.parts();
         if self.m_eq == 0 && self.gaps.is_empty() {
             self.step = self.q.iter().map(|x| -x).collect();
@@ -549,7 +560,6 @@ impl<'a> Sqp<'a> {
             self.z = Vec::new();
             return Ok(());
         }
-        self.exact_qp = false;
         if self.m_eq == 0 {
             // contact rows only: the exact active-set solution from the last
             // QP's forces on the same pairs (none at first), which settles in
@@ -600,16 +610,26 @@ impl<'a> Sqp<'a> {
         Ok(())
     }
 
-    /// Polish (equality rows only): Newton on the QP's KKT conditions with
-    /// the exact sparse KKT factorisation.
+    /// Polish (equality rows only): Newton on the QP's KKT conditions, unless
+    /// the QP was solved exactly.
     fn polish_equality_step(&mut self) {
+        if !self.exact_qp {
+            self.kkt_newton();
+        }
+    }
+
+    /// Equality rows only: two Newton steps on the QP's KKT conditions from
+    /// the step and multipliers at hand, with the exact sparse KKT
+    /// factorisation (from zero, the first solves the QP; the second
+    /// refines). False if there is no KKT system or it cannot be factored.
+    fn kkt_newton(&mut self) -> bool {
         let Some(kkt) = self.kkt.as_mut().filter(|_| self.gaps.is_empty()) else {
-            return;
+            return false;
         };
         let (pat, vals, _) = self.hessian.parts();
         kkt.assemble(vals, &self.rows);
         if kkt.ldlt.factor(&kkt.values).is_err() {
-            return;
+            return false;
         }
         self.report.factorizations += 1;
         let n = self.n;
@@ -631,6 +651,7 @@ impl<'a> Sqp<'a> {
                 .zip(&r[n..])
                 .for_each(|(x, y)| *x += y);
         }
+        self.step.iter().chain(&self.lambda).all(|v| v.is_finite())
     }
 
     /// Polish (contacts, no equality rows): the exact QP solution by an
