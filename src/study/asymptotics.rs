@@ -6,7 +6,8 @@
 use crate::analysis::event::{Event, EventKind};
 use crate::scene::Scene;
 use crate::solve::root::bisect_predicate;
-use crate::study::error::{Context, Result, fail};
+use crate::study::error::{Context, Result, StudyError, fail};
+use crate::study::observer::both;
 use crate::study::run::run_scene;
 use std::f64::consts::PI;
 
@@ -88,7 +89,28 @@ pub fn crosses_one_contact_curve(segments: usize, z_star: f64, delta: f64) -> Re
     let cont = "[continuation]\nparameter = \"phi\"\nrange = [0.9, 0.99999]\ndirection = \"down\"\nstep = 0.0002\nmax_step = 0.0005\n";
     let start = 1.0 - 0.2 * delta / (2.0 * PI);
     let scene = strip_scene(segments, z_star, delta, start, cont)?;
-    Ok(crossings(&scene)?.len() >= 2)
+    // the answer is known at the second crossing: the run stops there
+    let mut seen = 0;
+    let mut stop_at_second = both(
+        |_| Ok(()),
+        |e: &Event| {
+            seen += usize::from(e.kind == EventKind::Crossing);
+            if seen >= 2 {
+                Err(StudyError::Observer("two crossings".into()))
+            } else {
+                Ok(())
+            }
+        },
+    );
+    match run_scene(&scene, None, &mut stop_at_second) {
+        Err(StudyError::Observer(_)) => Ok(true),
+        Err(e) => Err(e),
+        Ok(events) => Ok(events
+            .iter()
+            .filter(|e| e.kind == EventKind::Crossing)
+            .count()
+            >= 2),
+    }
 }
 
 /// Largest z* of the one-contact curve at end shift δ, by bisection on
