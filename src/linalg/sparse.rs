@@ -232,25 +232,29 @@ impl Ldlt {
             Spec::<LdltParams, f64>::default(),
         );
         self.factored = res.is_ok();
-        let ok = res.is_ok() && self.diagonal().iter().all(|d| d.is_finite() && *d != 0.0);
+        let ok = res.is_ok() && self.pivots().all(|d| d.is_finite() && d != 0.0);
         self.factored = ok;
         if ok { Ok(()) } else { Err(SingularPivot) }
     }
 
     /// Diagonal D of the last factorisation.
     pub fn diagonal(&self) -> Vec<f64> {
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(s) => {
-                let cp = s.col_ptr();
-                (0..s.nrows()).map(|c| self.factor[cp[c]]).collect()
-            }
+        self.pivots().collect()
+    }
+
+    /// The pivots (D's diagonal) of the last factorisation, without
+    /// collecting them (each factorisation checks them).
+    fn pivots(&self) -> impl Iterator<Item = f64> + '_ {
+        let cp = match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr(),
             SymbolicCholeskyRaw::Supernodal(_) => unreachable!("simplicial forced"),
-        }
+        };
+        cp[..cp.len() - 1].iter().map(|&k| self.factor[k])
     }
 
     /// Number of negative pivots = number of negative eigenvalues (Sylvester).
     pub fn negative_count(&self) -> usize {
-        self.diagonal().iter().filter(|d| **d < 0.0).count()
+        self.pivots().filter(|d| *d < 0.0).count()
     }
 
     /// Solve A x = b in place.

@@ -544,9 +544,11 @@ impl<'a> Sqp<'a> {
         self.exact_qp = false;
         if self.m_eq > 0 && self.gaps.is_empty() {
             // equality rows only: the QP is its KKT system, solved exactly
-            self.step = vec![0.0; self.n];
-            self.lambda = vec![0.0; self.m_eq];
-            self.z = Vec::new();
+            self.step.clear();
+            self.step.resize(self.n, 0.0);
+            self.lambda.clear();
+            self.lambda.resize(self.m_eq, 0.0);
+            self.z.clear();
             if self.kkt_newton() {
                 self.exact_qp = true;
                 return Ok(());

@@ -33,7 +33,7 @@ fn contact_table(scenes: &Path) -> Result<String> {
     )?;
     writeln!(s, "| quantity | knotrod | paper |\n|---|---|---|")?;
     s += &configuration_a_rows(a)?;
-    s += &event_rows(&events)?;
+    s += &event_rows(&events, &eqs)?;
     Ok(s)
 }
 
@@ -60,8 +60,9 @@ fn configuration_a_rows(a: &Equilibrium) -> Result<String> {
     Ok(s)
 }
 
-/// Where contacts are lost, jumps and walls occur, up and back down.
-fn event_rows(events: &[Event]) -> Result<String> {
+/// Where contacts are lost, jumps and walls occur, up and back down (and
+/// where the strands first touch each other on the way up, from `eqs`).
+fn event_rows(events: &[Event], eqs: &[Equilibrium]) -> Result<String> {
     let mut s = String::new();
     let find_with = |kind: EventKind, leg: usize, detail: &str| {
         events
@@ -84,15 +85,25 @@ fn event_rows(events: &[Event]) -> Result<String> {
         "| B: ray contact force reaches zero (up) | φ/2π = {} | 0.768 |",
         find_with(EventKind::ContactLost, 0, "ray")
     )?;
-    let self_lost = find_with(EventKind::ContactLost, 0, "self");
-    writeln!(
-        s,
-        "| self-contact lost (up; near X the strands touch instead of crossing) | φ/2π = {} | — (no contact in the paper's X) |",
-        if self_lost.is_empty() {
+    let or_none = |found: String| {
+        if found.is_empty() {
             "none".to_string()
         } else {
-            self_lost
+            found
         }
+    };
+    // the loading path's equilibria are 0.01 apart in φ/2π; a contact's
+    // start is not located as an event
+    let first_touch = eqs
+        .iter()
+        .find(|e| e.branch == 0 && e.contacts.iter().any(|c| c.obstacle == "self"))
+        .map(|e| format!("{:.2}", e.phi_over_2pi))
+        .unwrap_or_default();
+    writeln!(
+        s,
+        "| self-contact near X (the strands touch instead of crossing): first equilibrium touching on the way up; lost on the way down | φ/2π = {}; {} | — (no contact in the paper's X) |",
+        or_none(first_touch),
+        or_none(find_with(EventKind::ContactLost, 1, "self"))
     )?;
     writeln!(
         s,

@@ -18,7 +18,7 @@ pub(super) fn section(scenes: &Path) -> Result<String> {
     )?;
     writeln!(
         s,
-        "`scenes/fig8_strip.toml`: Sadowsky law with u2 = 0 enforced (SQP, clarabel QPs polished on the KKT system), started from the double ring unfolded into the knotted wedge, continued on the KKT system. Paper: a stable walled knotted strip with no self-contact at z* = 0.215, φ/2π ≈ 0.94; no pitchfork, branches down to φ/2π < 0.5.\n"
+        "`scenes/fig8_strip.toml`: Sadowsky law with u2 = 0 enforced (SQP, each QP solved on the KKT system), started from the double ring unfolded into the knotted wedge, continued on the KKT system. Paper: a stable walled knotted strip with no self-contact at z* = 0.215, φ/2π ≈ 0.94; no pitchfork, branches down to φ/2π < 0.5.\n"
     )?;
     s += &strip_table(scenes)?;
     writeln!(
