@@ -94,14 +94,20 @@ fn event_rows(events: &[Event], eqs: &[Equilibrium]) -> Result<String> {
     };
     // the loading path's equilibria are 0.01 apart in φ/2π; a contact's
     // start is not located as an event
+    // past B (before it the knot presses on itself around the rays)
+    let b = events
+        .iter()
+        .find(|e| e.kind == EventKind::ContactLost && e.branch == 0 && e.detail.contains("ray"))
+        .map_or(f64::INFINITY, |e| e.phi_over_2pi);
     let first_touch = eqs
         .iter()
-        .find(|e| e.branch == 0 && e.contacts.iter().any(|c| c.obstacle == "self"))
+        .filter(|e| e.branch == 0 && e.phi_over_2pi > b)
+        .find(|e| e.contacts.iter().any(|c| c.obstacle == "self"))
         .map(|e| format!("{:.2}", e.phi_over_2pi))
         .unwrap_or_default();
     writeln!(
         s,
-        "| self-contact near X (the strands touch instead of crossing): first equilibrium touching on the way up; lost on the way down | φ/2π = {}; {} | — (no contact in the paper's X) |",
+        "| self-contact near X (the strands touch instead of crossing): first equilibrium touching on the way up past B; lost on the way down | φ/2π = {}; {} | — (no contact in the paper's X) |",
         or_none(first_touch),
         or_none(find_with(EventKind::ContactLost, 1, "self"))
     )?;
